@@ -1,0 +1,13 @@
+// Subcommand registration. Each register_* adds one subcommand whose callback runs the
+// command; errors a user can cause are thrown as std::runtime_error with a message that
+// names the problem and the fix, and main() prints them and exits with status 2.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace pamdp::app {
+
+void register_eval(CLI::App& app);
+void register_sim(CLI::App& app);
+
+}  // namespace pamdp::app

@@ -1,0 +1,31 @@
+// pamdp: one executable, one subcommand per role or tool.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "app/commands.hpp"
+#include "core/log.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"pamdp: DDPG in parameterized action spaces (Hausknecht & Stone, ICLR 2016) on Half Field Offense"};
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->each([](const std::string& level) { pamdp::log::set_level(level); })
+      ->capture_default_str();
+
+  pamdp::app::register_eval(app);
+  pamdp::app::register_sim(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pamdp: error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

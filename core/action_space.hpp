@@ -1,0 +1,47 @@
+// Parameterized action spaces (PAMDP): a finite set of discrete actions, each owning a subset
+// of one shared vector of continuous parameters.
+//
+// The shared layout follows the paper's actor output: the network emits one score per discrete
+// action and one value per parameter; discrete action k reads only the parameters listed in
+// `actions[k].param_indices`. Every env describes itself with one ActionSpace, so the learner,
+// the actors and exploration never need to know which env they drive.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pamdp {
+
+struct ParamSpec {
+  std::string name;  // e.g. "dash_power"
+  float lo = 0.0F;   // bounds the actor's output is kept within (paper §5, reference §7.4)
+  float hi = 0.0F;
+};
+
+struct DiscreteActionSpec {
+  std::string name;                // e.g. "DASH"
+  std::vector<int> param_indices;  // indices into ActionSpace::params
+};
+
+struct ActionSpace {
+  std::vector<DiscreteActionSpec> actions;
+  std::vector<ParamSpec> params;
+
+  [[nodiscard]] int num_actions() const { return static_cast<int>(actions.size()); }
+  [[nodiscard]] int num_params() const { return static_cast<int>(params.size()); }
+  // Width of the actor's output: one score per action plus every parameter.
+  [[nodiscard]] int output_width() const { return num_actions() + num_params(); }
+  // Index of the action with this name, or -1.
+  [[nodiscard]] int find_action(std::string_view name) const;
+};
+
+// One chosen action: the discrete id and a view of the whole parameter vector (only the
+// entries the action owns are read). Non-owning; valid for the duration of a step() call.
+struct ParamAction {
+  int id = 0;
+  std::span<const float> params;
+};
+
+}  // namespace pamdp

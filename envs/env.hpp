@@ -1,0 +1,54 @@
+// The environment interface every PAMDP env implements (the embedded soccer simulator, the
+// real HFO server, toy tasks for tests). The rest of the system talks only to this.
+//
+// Contract:
+//  - Observations are written into a caller-owned span of exactly observation_size() floats.
+//  - reset(seed) starts a new episode; the same seed on a freshly constructed env gives the
+//    same episode. reset() without a seed continues the env's own random stream.
+//  - step() applies one action and advances one decision step. After a terminal status the
+//    caller must reset() before stepping again.
+//  - Status 0 means "episode goes on"; any other value is a terminal outcome named by
+//    status_name(). An env lists every outcome it can produce in outcomes().
+//  - Not thread-safe: one env per thread. step() and reset() must not allocate.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "core/action_space.hpp"
+
+namespace pamdp {
+
+struct StepResult {
+  float reward = 0.0F;
+  int status = 0;  // 0 = in progress; otherwise the env's terminal outcome code
+  [[nodiscard]] bool terminal() const { return status != 0; }
+};
+
+class Env {
+ public:
+  Env() = default;
+  Env(const Env&) = delete;
+  Env& operator=(const Env&) = delete;
+  virtual ~Env() = default;
+
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  [[nodiscard]] virtual const ActionSpace& action_space() const = 0;
+  [[nodiscard]] virtual int observation_size() const = 0;
+  // Upper bound on decision steps in one episode (for harnesses and buffer sizing).
+  [[nodiscard]] virtual int max_episode_steps() const = 0;
+
+  // Human name of a status code ("IN_GAME", "GOAL", ...).
+  [[nodiscard]] virtual std::string_view status_name(int status) const = 0;
+  // Every status code this env can return, 0 first.
+  [[nodiscard]] virtual std::span<const int> outcomes() const = 0;
+  // The terminal status that counts as success (scoring rate), or -1 if none.
+  [[nodiscard]] virtual int success_status() const = 0;
+
+  virtual void reset(uint64_t seed, std::span<float> obs) = 0;
+  virtual void reset(std::span<float> obs) = 0;
+  virtual StepResult step(const ParamAction& action, std::span<float> obs) = 0;
+};
+
+}  // namespace pamdp

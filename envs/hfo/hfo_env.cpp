@@ -1,0 +1,106 @@
+#include "envs/hfo/hfo_env.hpp"
+
+#include <cassert>
+#include <cmath>
+
+namespace pamdp::hfo {
+
+const ActionSpace& hfo_action_space() {
+  static const ActionSpace kSpace{
+      .actions = {{"DASH", {param::kDashPower, param::kDashDir}},
+                  {"TURN", {param::kTurnDir}},
+                  {"TACKLE", {param::kTackleDir}},
+                  {"KICK", {param::kKickPower, param::kKickDir}}},
+      .params = {{"dash_power", 0.0F, 100.0F},
+                 {"dash_dir", -180.0F, 180.0F},
+                 {"turn_dir", -180.0F, 180.0F},
+                 {"tackle_dir", -180.0F, 180.0F},
+                 {"kick_power", 0.0F, 100.0F},
+                 {"kick_dir", -180.0F, 180.0F}},
+  };
+  return kSpace;
+}
+
+ShapedReward::Snapshot ShapedReward::snapshot(std::span<const float> f) {
+  // Distances in proximity units: D = 1 - P in [0, 2]. The ball-goal distance follows from
+  // the two egocentric bearings by the law of cosines, exactly as dqn-hfo did; the bearing
+  // of an object is sgn(sin) * acos(cos), so cos(tb - tg) expands without calling acos.
+  const double pb = f[feat::kBallProximity];
+  const double pg = f[feat::kGoalCentre + 2];
+  const double db = 1.0 - pb;
+  const double dg = 1.0 - pg;
+  const double cb = f[feat::kBallAngleCos];
+  const double cg = f[feat::kGoalCentre + 1];
+  const double sb = std::copysign(std::sqrt(std::max(0.0, 1.0 - cb * cb)), f[feat::kBallAngleSin] < 0 ? -1.0 : 1.0);
+  const double sg = std::copysign(std::sqrt(std::max(0.0, 1.0 - cg * cg)), f[feat::kGoalCentre] < 0 ? -1.0 : 1.0);
+  const double cos_diff = cb * cg + sb * sg;
+  const double dbg2 = db * db + dg * dg - 2.0 * db * dg * cos_diff;
+  return {pb, f[feat::kKickable], std::sqrt(std::max(0.0, dbg2))};
+}
+
+float ShapedReward::operator()(std::span<const float> features, int status) {
+  const Snapshot now = snapshot(features);
+  double d_prox = 0.0;
+  double d_kick = 0.0;
+  double d_dist = 0.0;
+  if (steps_ > 0) {
+    d_prox = now.ball_prox - prev_.ball_prox;
+    d_kick = now.kickable - prev_.kickable;
+    d_dist = now.ball_goal_dist - prev_.ball_goal_dist;
+  }
+  prev_ = now;
+  if (status != kInGame) {
+    d_prox = d_kick = d_dist = 0.0;
+  }
+  double r = d_prox - 3.0 * d_dist + (status == kGoal ? 5.0 : 0.0);
+  if (d_kick >= 1.0 && !got_kick_) {
+    r += 1.0;
+    got_kick_ = true;
+  }
+  ++steps_;
+  return static_cast<float>(r);
+}
+
+HfoEnv::HfoEnv(const SoccerSimConfig& config) : sim_(config) {}
+
+std::span<const int> HfoEnv::outcomes() const {
+  static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
+  return kOutcomes;
+}
+
+void HfoEnv::begin_episode(std::span<float> obs) {
+  reward_.reset();
+  write_features(sim_.state(), obs);
+}
+
+void HfoEnv::reset(uint64_t seed, std::span<float> obs) {
+  sim_.reseed(seed);
+  reset(obs);
+}
+
+void HfoEnv::reset(std::span<float> obs) {
+  sim_.reset_episode();
+  begin_episode(obs);
+}
+
+void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, std::span<float> obs) {
+  sim_.set_state(agent, ball);
+  begin_episode(obs);
+}
+
+StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
+  assert(action.params.size() >= static_cast<size_t>(param::kCount));
+  const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
+  switch (action.id) {
+    case kDash: sim_.dash(p(param::kDashPower), p(param::kDashDir)); break;
+    case kTurn: sim_.turn(p(param::kTurnDir)); break;
+    case kTackle: sim_.tackle(p(param::kTackleDir)); break;
+    case kKick: sim_.kick(p(param::kKickPower), p(param::kKickDir)); break;
+    default: assert(false && "action id out of range"); break;
+  }
+  const int status = sim_.step();
+  write_features(sim_.state(), obs);
+  return {reward_(obs, status), status};
+}
+
+}  // namespace pamdp::hfo

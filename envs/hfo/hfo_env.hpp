@@ -1,0 +1,81 @@
+// HfoEnv: the embedded Half Field Offense task (1v0 by default) behind the Env interface:
+// SoccerSim physics and referee, the 58 features, the paper's four parameterized actions and
+// the reward dqn-hfo computed from features (reference §6.2).
+#pragma once
+
+#include <array>
+#include <span>
+
+#include "envs/env.hpp"
+#include "envs/hfo/features.hpp"
+#include "envs/hfo/soccer_sim.hpp"
+
+namespace pamdp::hfo {
+
+// Discrete action ids (reference §4) and indices into the shared 6-parameter vector.
+enum ActionId : int { kDash = 0, kTurn = 1, kTackle = 2, kKick = 3 };
+namespace param {
+inline constexpr int kDashPower = 0;
+inline constexpr int kDashDir = 1;
+inline constexpr int kTurnDir = 2;
+inline constexpr int kTackleDir = 3;
+inline constexpr int kKickPower = 4;
+inline constexpr int kKickDir = 5;
+inline constexpr int kCount = 6;
+}  // namespace param
+
+// The paper's action space: DASH(power, dir), TURN(dir), TACKLE(dir), KICK(power, dir), with
+// the bounds the actor is kept in (reference §7.4 step 5).
+const ActionSpace& hfo_action_space();
+
+// The shaped reward of dqn-hfo, computed from consecutive feature vectors (reference §6.2):
+// no shaping on the first transition of an episode nor on the terminal one, kickable bonus
+// once per episode, 5 for a goal.
+class ShapedReward {
+ public:
+  void reset() {
+    steps_ = 0;
+    got_kick_ = false;
+  }
+  float operator()(std::span<const float> features, int status);
+
+ private:
+  struct Snapshot {
+    double ball_prox = 0.0;
+    double kickable = 0.0;
+    double ball_goal_dist = 0.0;
+  };
+  static Snapshot snapshot(std::span<const float> f);
+  Snapshot prev_;
+  int steps_ = 0;
+  bool got_kick_ = false;
+};
+
+class HfoEnv final : public Env {
+ public:
+  explicit HfoEnv(const SoccerSimConfig& config = {});
+
+  [[nodiscard]] std::string_view name() const override { return "hfo"; }
+  [[nodiscard]] const ActionSpace& action_space() const override { return hfo_action_space(); }
+  [[nodiscard]] int observation_size() const override { return feature_count(sim_.state().num_players); }
+  [[nodiscard]] int max_episode_steps() const override { return sim_.config().max_steps + 1; }
+  [[nodiscard]] std::string_view status_name(int status) const override { return hfo::status_name(status); }
+  [[nodiscard]] std::span<const int> outcomes() const override;
+  [[nodiscard]] int success_status() const override { return kGoal; }
+
+  void reset(uint64_t seed, std::span<float> obs) override;
+  void reset(std::span<float> obs) override;
+  StepResult step(const ParamAction& action, std::span<float> obs) override;
+
+  // Starts an episode from an explicit state (tests, `pamdp sim trace`).
+  void set_state(const PlayerState& agent, const BallState& ball, std::span<float> obs);
+  [[nodiscard]] const SoccerSim& sim() const { return sim_; }
+
+ private:
+  void begin_episode(std::span<float> obs);
+
+  SoccerSim sim_;
+  ShapedReward reward_;
+};
+
+}  // namespace pamdp::hfo

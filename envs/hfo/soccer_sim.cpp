@@ -1,0 +1,532 @@
+#include "envs/hfo/soccer_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pamdp::hfo {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Goal line test of the server referee: the ball's centre must pass x = 52.5 + ball radius,
+// between the outer edges of the posts (reference §5.2).
+constexpr double kGoalLineX = kPitchHalfLength + kBallSize;       // 52.585
+constexpr double kGoalMouthY = kGoalHalfWidth + kGoalPostRadius;  // 7.07
+// Separation the server leaves between an object and a post after a bounce, so that the
+// reflected remainder of the move is not detected at the same contact point again.
+constexpr double kPostSeparation = 1e-10;
+constexpr double kCollisionSeparation = 1e-10;
+// E1 trainer: a player "holds" the ball within 1.5 x the kickable area.
+constexpr double kTrainerHoldDist = 1.5 * (kKickableMargin + kPlayerSize + kBallSize);
+
+double round3(double x) {
+  return std::nearbyint(x * 1000.0) / 1000.0;
+}
+
+double dash_dir_rate(double dir_deg) {
+  const double a = std::fabs(dir_deg);
+  const double rate = a <= 90.0 ? kSideDashRate + (1.0 - kSideDashRate) * (1.0 - a / 90.0)
+                                : kBackDashRate - (kBackDashRate - kSideDashRate) * (1.0 - (a - 90.0) / 90.0);
+  return clamp(rate, 0.0, 1.0);
+}
+
+double discretize_dash_dir(double dir_deg) {
+  return kDashAngleStep * std::nearbyint(dir_deg / kDashAngleStep);
+}
+
+// Centre of the post in the same quadrant as p (the only post p can reach in one cycle).
+Vec2 nearest_post(Vec2 p) {
+  return {p.x >= 0.0 ? kPitchHalfLength - kGoalPostRadius : -(kPitchHalfLength - kGoalPostRadius),
+          p.y >= 0.0 ? kGoalHalfWidth + kGoalPostRadius : -(kGoalHalfWidth + kGoalPostRadius)};
+}
+
+// Earliest t in [0, 1] at which a circle of radius r moving from p by m touches centre c, or -1.
+double post_contact_time(Vec2 p, Vec2 m, Vec2 c, double r) {
+  const Vec2 d = p - c;
+  const double a = m.r2();
+  const double b = 2.0 * d.dot(m);
+  const double cc = d.r2() - r * r;
+  if (a == 0.0 || b >= 0.0 || cc < 0.0) {
+    return -1.0;  // not moving, moving away, or already overlapping (handled separately)
+  }
+  const double disc = b * b - 4.0 * a * cc;
+  if (disc < 0.0) {
+    return -1.0;
+  }
+  const double t = (-b - std::sqrt(disc)) / (2.0 * a);
+  return (t >= 0.0 && t <= 1.0) ? t : -1.0;
+}
+
+Vec2 reflect(Vec2 v, Vec2 unit_normal) {
+  return v - unit_normal * (2.0 * v.dot(unit_normal));
+}
+
+}  // namespace
+
+const char* status_name(int status) {
+  switch (status) {
+    case kInGame: return "IN_GAME";
+    case kGoal: return "GOAL";
+    case kCapturedByDefense: return "CAPTURED_BY_DEFENSE";
+    case kOutOfBounds: return "OUT_OF_BOUNDS";
+    case kOutOfTime: return "OUT_OF_TIME";
+    default: return "UNKNOWN";
+  }
+}
+
+SoccerSim::SoccerSim(const SoccerSimConfig& config, uint64_t seed) : config_(config), rng_(seed) {
+  state_.players[0].pos = {0.0, 0.0};
+  state_.ball.pos = {10.0, 0.0};
+  state_.prev_ball = state_.ball.pos;
+}
+
+void SoccerSim::reset_episode() {
+  // Ball (velocity 0), reference §5.1.
+  double bx = 0.0;
+  switch (config_.start) {
+    case StartDistribution::kPaper: bx = 0.2 * rng_.uniform(-0.1, kPitchHalfLength) + 5.25; break;
+    case StartDistribution::kDec2015:
+    case StartDistribution::kHfo: bx = kPitchHalfLength * rng_.uniform(0.0, 0.2); break;
+  }
+  const double by = kPitchHalfWidth * rng_.uniform(-0.8, 0.8);
+
+  // Agent: one of ten offsets around the ball, then the era's clamp.
+  static constexpr std::array<std::array<double, 2>, 10> kOffsets{
+      {{-1, -1}, {-1, 1}, {1, 1}, {1, -1}, {0, 2}, {0, -2}, {-2, -2}, {-2, 2}, {2, 2}, {2, -2}}};
+  const auto& off = kOffsets[rng_.below(kOffsets.size())];
+  double ax = bx + 10.5 * (rng_.uniform() + off[0]);
+  double ay = by + 10.5 * (rng_.uniform() + off[1]);
+  switch (config_.start) {
+    case StartDistribution::kPaper:
+      ax = clamp(ax, -0.1, kPitchHalfLength);
+      ay = clamp(ay, -kPitchHalfWidth, kPitchHalfWidth);
+      break;
+    case StartDistribution::kDec2015:
+      ax = clamp(ax, -0.1, 21.0);
+      ay = clamp(ay, -27.2, 27.2);
+      break;
+    case StartDistribution::kHfo:
+      ax = clamp(ax, -0.1, kPitchHalfLength);
+      ay = clamp(ay, -27.2, 27.2);
+      break;
+  }
+
+  PlayerState& agent = state_.players[0];
+  double body = agent.body_deg;
+  switch (config_.body_at_reset) {
+    case BodyAtReset::kCarry: body = first_episode_ ? 0.0 : agent.body_deg; break;
+    case BodyAtReset::kZero: body = 0.0; break;
+    case BodyAtReset::kUniform: body = wrap_deg(rng_.uniform(-180.0, 180.0)); break;
+  }
+  first_episode_ = false;
+
+  PlayerState fresh;
+  fresh.pos = {ax, ay};
+  fresh.body_deg = body;
+  set_state(fresh, BallState{{bx, by}, {0.0, 0.0}});
+}
+
+void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
+  state_.players[0] = agent;
+  state_.players[0].body_deg = wrap_deg(agent.body_deg);
+  state_.ball = ball;
+  state_.cycle = 0;
+  state_.untouched = 0;
+  state_.prev_ball = ball.pos;
+  state_.defense_hold = 0;
+  state_.trainer_hold = 0;
+  player_accel_.fill(Vec2{});
+  ball_accel_ = {};
+}
+
+bool SoccerSim::agent_kickable() const {
+  return (state_.ball.pos - agent().pos).r() <= kClientKickableArea;
+}
+
+Vec2 SoccerSim::noise_vector(double max_radius) {
+  // Uniform radius (not area-uniform) and uniform direction, as the server draws it.
+  const double r = rng_.uniform(0.0, max_radius);
+  const double th = rng_.uniform(-kPi, kPi);
+  return polar(r, th);
+}
+
+bool SoccerSim::dash(double power, double dir_deg) {
+  PlayerState& p = state_.players[0];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
+  // --- Client (librcsc): wrap, clamp, discretize, conserve stamina and speed, round. ---
+  double dir = discretize_dash_dir(wrap_deg(dir_deg));
+  power = clamp(power, kMinDashPower, kMaxDashPower);
+  bool back = power < 0.0;
+  const double need = back ? -2.0 * power : power;
+  if (p.stamina + kExtraStamina < need) {
+    power = back ? -(p.stamina + kExtraStamina) / 2.0 : p.stamina + kExtraStamina;
+  }
+  {
+    const double rate = dash_dir_rate(dir);
+    double acc = std::fabs(power * rate * p.effort * kDashPowerRate);
+    const double ang = (p.body_deg + dir + (back ? 180.0 : 0.0)) * kDegToRad;
+    const Vec2 unit{std::cos(ang), std::sin(ang)};
+    if ((p.vel + unit * acc).r2() > kPlayerSpeedMax * kPlayerSpeedMax + 1e-4 && rate * p.effort > 0.0) {
+      const double v_par = p.vel.dot(unit);
+      const double v_perp2 = std::max(0.0, p.vel.r2() - v_par * v_par);
+      acc = std::max(0.0, std::sqrt(std::max(0.0, kPlayerSpeedMax * kPlayerSpeedMax - v_perp2)) - v_par);
+      power = (back ? -acc : acc) / (kDashPowerRate * p.effort * rate);
+      power = clamp(power, kMinDashPower, kMaxDashPower);
+    }
+  }
+  power = round3(power);
+
+  // --- Server: clamp, discretize, consume stamina, push. ---
+  power = clamp(power, kMinDashPower, kMaxDashPower);
+  dir = discretize_dash_dir(clamp(dir, kMinMoment, kMaxMoment));
+  back = power < 0.0;
+  double spent = back ? -2.0 * power : power;
+  spent = std::min(spent, p.stamina + kExtraStamina);
+  p.stamina = std::max(0.0, p.stamina - spent);
+  power = back ? -spent / 2.0 : spent;
+  const double eff = std::fabs(p.effort * power * dash_dir_rate(dir) * kDashPowerRate);
+  player_accel_[0] += polar(eff, (p.body_deg + dir + (back ? 180.0 : 0.0)) * kDegToRad);
+  return true;
+}
+
+bool SoccerSim::turn(double dir_deg) {
+  PlayerState& p = state_.players[0];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
+  const double inertia = 1.0 + kInertiaMoment * p.vel.r();
+  // Client: HFO's Turn is the desired actual turn; pre-compensate inertia, clamp, round.
+  double moment = round3(clamp(wrap_deg(dir_deg) * inertia, kMinMoment, kMaxMoment));
+  // Server.
+  moment = clamp(moment, kMinMoment, kMaxMoment);
+  if (config_.noise) {
+    moment *= 1.0 + rng_.uniform(-kPlayerRand, kPlayerRand);
+  }
+  p.body_deg = wrap_deg(p.body_deg + moment / inertia);
+  return true;
+}
+
+bool SoccerSim::kick(double power, double dir_deg) {
+  PlayerState& p = state_.players[0];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
+  const Vec2 to_ball = state_.ball.pos - p.pos;
+  const double dist = to_ball.r();
+  // Client gating: no command at all unless the client calls the ball kickable.
+  if (dist > kClientKickableArea) {
+    return false;
+  }
+  power = round3(clamp(power, 0.0, kMaxKickPower));
+  const double dir = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
+  if (dist > kKickableArea) {
+    return true;  // sent, but the server ignores it (cannot happen behind the client gate)
+  }
+  const double phi = std::fabs(wrap_rad(std::atan2(to_ball.y, to_ball.x) - p.body_deg * kDegToRad));
+  const double gap = dist - kPlayerSize - kBallSize;
+  const double eff = power * kKickPowerRate * (1.0 - 0.25 * phi / kPi - 0.25 * gap / kKickableMargin);
+  Vec2 accel = polar(eff, (p.body_deg + dir) * kDegToRad);
+  if (config_.noise) {
+    const double max_r = kKickRand * (power / kMaxKickPower) *
+                         ((0.5 + 0.25 * (phi / kPi + gap / kKickableMargin)) +
+                          (0.5 + 0.5 * state_.ball.vel.r() / (kBallSpeedMax * kBallDecay)));
+    accel += noise_vector(max_r);
+  }
+  ball_accel_ += accel;
+  return true;
+}
+
+bool SoccerSim::tackle(double dir_deg) {
+  PlayerState& p = state_.players[0];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
+  p.tackle_cycles = kTackleCycles;
+  // Ball in the body frame.
+  const Vec2 d = state_.ball.pos - p.pos;
+  const double body = p.body_deg * kDegToRad;
+  const double c = std::cos(-body);
+  const double s = std::sin(-body);
+  const Vec2 q{d.x * c - d.y * s, d.x * s + d.y * c};
+  if (q.x <= 0.0) {
+    return true;  // the back tackle distance is 0: always fails
+  }
+  const double fail =
+      std::pow(q.x / kTackleDist, kTackleExponent) + std::pow(std::fabs(q.y) / kTackleWidth, kTackleExponent);
+  if (fail >= 1.0) {
+    return true;
+  }
+  // Success is drawn from the server's generator even with noise off.
+  if (rng_.uniform() < fail) {
+    return true;
+  }
+  const double a_deg = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
+  const double power = kMaxTacklePower + (kMaxBackTacklePower - kMaxTacklePower) * std::fabs(a_deg) / 180.0;
+  const double eff = power * kTacklePowerRate * (1.0 - 0.5 * std::fabs(std::atan2(q.y, q.x)) / kPi);
+  Vec2 accel = polar(eff, (p.body_deg + a_deg) * kDegToRad);
+  if (config_.noise) {
+    const double max_r =
+        kKickRand * kTackleRandFactor *
+        ((0.5 + 0.5 * (1.0 - fail)) + (0.5 + 0.5 * state_.ball.vel.r() / (kBallSpeedMax * kBallDecay)));
+    accel += noise_vector(max_r);
+  }
+  ball_accel_ += accel;
+  return true;
+}
+
+void SoccerSim::move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max,
+                            double speed_max, double rand, bool* hit_post) {
+  if (!accel.is_zero()) {
+    const double a = accel.r();
+    if (a > accel_max) {
+      accel *= accel_max / a;
+    }
+    vel += accel;
+    const double v = vel.r();
+    if (v > speed_max) {
+      vel *= speed_max / v;
+    }
+  }
+  if (config_.noise && rand > 0.0) {
+    vel += noise_vector(rand * vel.r());
+  }
+
+  // Goal posts: circles of radius 0.06; elastic bounce, reference §2.3 step 5.
+  const double reach = size + kGoalPostRadius;
+  {
+    const Vec2 c = nearest_post(pos);
+    const Vec2 d = pos - c;
+    const double dist = d.r();
+    if (dist < reach) {
+      const Vec2 n = dist > 0.0 ? d * (1.0 / dist) : Vec2{pos.x >= 0.0 ? 1.0 : -1.0, 0.0};
+      pos = c + n * (reach + kPostSeparation);
+      if (vel.dot(n) < 0.0) {
+        vel = reflect(vel, n);
+      }
+      if (hit_post != nullptr) {
+        *hit_post = true;
+      }
+    }
+  }
+  Vec2 move = vel;
+  for (int bounce = 0; bounce < 8; ++bounce) {
+    const Vec2 c1 = nearest_post(pos);
+    const Vec2 c2 = nearest_post(pos + move);
+    double t = post_contact_time(pos, move, c1, reach);
+    Vec2 c = c1;
+    if (!(c2 == c1)) {
+      const double t2 = post_contact_time(pos, move, c2, reach);
+      if (t2 >= 0.0 && (t < 0.0 || t2 < t)) {
+        t = t2;
+        c = c2;
+      }
+    }
+    if (t < 0.0) {
+      break;
+    }
+    const Vec2 contact = pos + move * t;
+    Vec2 n = contact - c;
+    n *= 1.0 / n.r();
+    move = reflect(move * (1.0 - t), n);
+    vel = reflect(vel, n);
+    pos = contact + n * kPostSeparation;
+    if (hit_post != nullptr) {
+      *hit_post = true;
+    }
+  }
+  pos += move;
+  vel *= decay;
+  accel = {};
+}
+
+void SoccerSim::collide_objects() {
+  // Objects: index 0 is the ball, 1..n the players (reference §2.9).
+  constexpr int kMaxObjects = SoccerState::kMaxPlayers + 1;
+  const int n = state_.num_players + 1;
+  std::array<Vec2*, kMaxObjects> pos{};
+  std::array<double, kMaxObjects> size{};
+  std::array<bool, kMaxObjects> collided{};
+  pos[0] = &state_.ball.pos;
+  size[0] = kBallSize;
+  for (int i = 1; i < n; ++i) {
+    pos[i] = &state_.players[i - 1].pos;
+    size[i] = kPlayerSize;
+  }
+  for (int pass = 0; pass < 10; ++pass) {
+    std::array<Vec2, kMaxObjects> sum{};
+    std::array<int, kMaxObjects> count{};
+    bool any = false;
+    for (int a = 0; a < n; ++a) {
+      for (int b = a + 1; b < n; ++b) {
+        const double reach = size[a] + size[b];
+        Vec2 d = *pos[b] - *pos[a];
+        double dist = d.r();
+        if (dist >= reach) {
+          continue;
+        }
+        any = true;
+        collided[a] = collided[b] = true;
+        if (a == 0) {
+          state_.players[b - 1].collided_ball = true;
+        } else {
+          state_.players[a - 1].collided_player = true;
+          state_.players[b - 1].collided_player = true;
+        }
+        const Vec2 mid = (*pos[a] + *pos[b]) * 0.5;
+        if (dist <= 0.0) {
+          d = polar(1.0, rng_.uniform(-kPi, kPi));
+          dist = 1.0;
+        }
+        const Vec2 unit = d * (1.0 / dist);
+        double half = reach * 0.5 + kCollisionSeparation;
+        Vec2 pa = mid - unit * half;
+        Vec2 pb = mid + unit * half;
+        for (int nudge = 0; nudge < 10 && (pb - pa).r() < reach; ++nudge) {
+          half *= 1.0001;
+          pa = mid - unit * half;
+          pb = mid + unit * half;
+        }
+        sum[a] += pa;
+        sum[b] += pb;
+        ++count[a];
+        ++count[b];
+      }
+    }
+    if (!any) {
+      break;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (count[i] > 0) {
+        *pos[i] = sum[i] * (1.0 / count[i]);
+      }
+    }
+  }
+  if (collided[0]) {
+    state_.ball.vel *= -0.1;
+  }
+  for (int i = 1; i < n; ++i) {
+    if (collided[i]) {
+      state_.players[i - 1].vel *= -0.1;
+    }
+  }
+}
+
+void SoccerSim::update_stamina(PlayerState& p) {
+  if (p.stamina <= kRecoverDecThreshold && p.recovery > kRecoverMin) {
+    p.recovery = std::max(kRecoverMin, p.recovery - kRecoverDec);
+  }
+  if (p.stamina <= kEffortDecThreshold && p.effort > kEffortMin) {
+    p.effort = std::max(kEffortMin, p.effort - kEffortDec);
+  }
+  if (p.stamina >= kEffortIncThreshold && p.effort < kEffortMax) {
+    p.effort = std::min(kEffortMax, p.effort + kEffortInc);
+  }
+  const double inc = std::min({p.recovery * kStaminaIncMax, kStaminaMax - p.stamina, p.capacity});
+  p.stamina = std::min(kStaminaMax, p.stamina + std::max(0.0, inc));
+  p.capacity = std::max(0.0, p.capacity - std::max(0.0, inc));
+}
+
+int SoccerSim::step() {
+  const int np = state_.num_players;
+  for (int i = 0; i < np; ++i) {
+    PlayerState& p = state_.players[i];
+    if (p.tackle_cycles > 0) {
+      --p.tackle_cycles;
+    }
+    // Collision flags describe this cycle only.
+    p.collided_ball = p.collided_player = p.collided_post = false;
+  }
+  for (int i = 0; i < np; ++i) {
+    PlayerState& p = state_.players[i];
+    move_object(p.pos, p.vel, player_accel_[i], kPlayerSize, kPlayerDecay, kPlayerAccelMax, kPlayerSpeedMax,
+                kPlayerRand, &p.collided_post);
+  }
+  move_object(state_.ball.pos, state_.ball.vel, ball_accel_, kBallSize, kBallDecay, kBallAccelMax, kBallSpeedMax,
+              kBallRand, nullptr);
+  collide_objects();
+  ++state_.cycle;
+  const int status = config_.referee == Referee::kServer ? referee_server() : referee_trainer();
+  for (int i = 0; i < np; ++i) {
+    update_stamina(state_.players[i]);
+  }
+  return status;
+}
+
+int SoccerSim::referee_server() {
+  const Vec2 ball = state_.ball.pos;
+  const Vec2 prev = state_.prev_ball;
+  state_.prev_ball = ball;
+
+  if (std::fabs(prev.x) <= kGoalLineX && ball.x > kGoalLineX) {
+    const double t = (kGoalLineX - prev.x) / (ball.x - prev.x);
+    const double y = prev.y + t * (ball.y - prev.y);
+    if (std::fabs(y) <= kGoalMouthY) {
+      return kGoal;
+    }
+  }
+  if (prev.x < 0.0 || prev.x > kPitchHalfLength || std::fabs(prev.y) > kPitchHalfWidth) {
+    return kOutOfBounds;
+  }
+  bool defense_near = false;
+  bool goalie_near = false;
+  bool anyone_near = false;
+  for (int i = 0; i < state_.num_players; ++i) {
+    const PlayerState& p = state_.players[i];
+    if ((ball - p.pos).r() <= kKickableArea) {
+      anyone_near = true;
+      if (p.team == Team::kDefense) {
+        defense_near = true;
+        goalie_near = goalie_near || p.goalie;
+      }
+    }
+  }
+  state_.defense_hold = defense_near ? state_.defense_hold + 1 : 0;
+  if (goalie_near || state_.defense_hold >= 2) {
+    return kCapturedByDefense;
+  }
+  if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {
+    return kOutOfTime;
+  }
+  ++state_.untouched;
+  if (anyone_near) {
+    state_.untouched = 0;
+  }
+  return kInGame;
+}
+
+int SoccerSim::referee_trainer() {
+  const Vec2 ball = state_.ball.pos;
+  state_.prev_ball = ball;
+  // Who holds the ball: the only player within 1.6275 for two consecutive cycles.
+  int holders = 0;
+  bool defense_holder = false;
+  for (int i = 0; i < state_.num_players; ++i) {
+    if ((ball - state_.players[i].pos).r() <= kTrainerHoldDist) {
+      ++holders;
+      defense_holder = state_.players[i].team == Team::kDefense;
+    }
+  }
+  state_.trainer_hold = holders == 1 ? state_.trainer_hold + 1 : 0;
+  const bool held = state_.trainer_hold >= 2;
+  state_.untouched = held ? 0 : state_.untouched + 1;
+  if (state_.cycle <= 5) {
+    return kInGame;
+  }
+  if (ball.x > kPitchHalfLength && std::fabs(ball.y) <= kGoalHalfWidth) {
+    return kGoal;
+  }
+  if (ball.x < -0.1 || ball.x > kPitchHalfLength || std::fabs(ball.y) > kPitchHalfWidth) {
+    return kOutOfBounds;
+  }
+  if (held && defense_holder) {
+    return kCapturedByDefense;
+  }
+  if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {
+    return kOutOfTime;
+  }
+  return kInGame;
+}
+
+}  // namespace pamdp::hfo

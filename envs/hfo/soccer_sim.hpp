@@ -1,0 +1,143 @@
+// SoccerSim: an in-process re-implementation of the RoboCup 2D server physics and the HFO
+// referee for Half Field Offense, as specified in shared/hfo-reference.md (§1, §2, §5).
+//
+// It owns no socket and no global state: construct as many as you like, one per thread.
+// Every call below is O(players) and allocates nothing. The agent the features describe is
+// players()[0]; more players (a goalie, teammates) have room in the state and take part in
+// physics and the referee, but only the agent has a command interface for now.
+//
+// Units: metres, metres per cycle, degrees for every angle in this API (the server works in
+// radians internally; commands and features use degrees).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "core/rng.hpp"
+#include "envs/hfo/geometry.hpp"
+
+namespace pamdp::hfo {
+
+// HFO status codes (reference §4).
+enum Status : int {
+  kInGame = 0,
+  kGoal = 1,
+  kCapturedByDefense = 2,
+  kOutOfBounds = 3,
+  kOutOfTime = 4,
+};
+const char* status_name(int status);
+
+// Start-state distribution of the ball and the agent (reference §5.1).
+enum class StartDistribution {
+  kPaper,    // E1 trainer (the paper's runs): ball x U[5.23, 15.75]; agent clamp x [-0.1, 52.5], |y| <= 34
+  kDec2015,  // E2 server referee from Dec 2015: ball x U[0, 10.5]; agent clamp x [-0.1, 21], |y| <= 27.2
+  kHfo,      // E3 current HFO defaults: ball x U[0, 10.5]; agent clamp x [-0.1, 52.5], |y| <= 27.2
+};
+
+// What the agent's body angle is at an episode start (reference §5.1).
+enum class BodyAtReset {
+  kCarry,    // kept from the previous episode (real HFO); 0 in the first episode
+  kZero,     // always facing the goal
+  kUniform,  // drawn U[-180, 180) from the episode's seed
+};
+
+// Episode termination rules (reference §5.2 and §5.3).
+enum class Referee {
+  kServer,   // HFORef inside rcssserver (E2/E3): goal line crossing, OOB one cycle late
+  kTrainer,  // the paper-era Python trainer (E1): current-position tests, no end in 5 cycles
+};
+
+struct SoccerSimConfig {
+  bool noise = true;  // movement, turn, kick and tackle noise (tackle success is always drawn)
+  StartDistribution start = StartDistribution::kPaper;
+  BodyAtReset body_at_reset = BodyAtReset::kCarry;
+  Referee referee = Referee::kServer;
+  int max_steps = 500;        // --frames-per-trial used by dqn-hfo
+  int untouched_limit = 100;  // cycles the ball may stay untouched
+};
+
+enum class Team : uint8_t { kOffense, kDefense };
+
+struct PlayerState {
+  Vec2 pos;
+  Vec2 vel;               // observed (post-decay) velocity
+  double body_deg = 0.0;  // global body angle, in (-180, 180]
+  double stamina = kStaminaMax;
+  double effort = 1.0;
+  double recovery = 1.0;
+  double capacity = kStaminaCapacity;
+  int tackle_cycles = 0;  // > 0 while frozen after a tackle
+  bool collided_ball = false;
+  bool collided_player = false;
+  bool collided_post = false;
+  Team team = Team::kOffense;
+  bool goalie = false;
+};
+
+struct BallState {
+  Vec2 pos;
+  Vec2 vel;  // observed (post-decay) velocity
+};
+
+// Everything the physics and the referee need to continue an episode.
+struct SoccerState {
+  static constexpr int kMaxPlayers = 4;
+  std::array<PlayerState, kMaxPlayers> players{};
+  int num_players = 1;
+  BallState ball;
+  int cycle = 0;         // cycles since the episode started
+  int untouched = 0;     // referee's untouched-ball counter
+  Vec2 prev_ball;        // ball position at the previous referee check
+  int defense_hold = 0;  // consecutive checks a defender was on the ball
+  int trainer_hold = 0;  // E1: consecutive cycles one player held the ball
+};
+
+class SoccerSim {
+ public:
+  explicit SoccerSim(const SoccerSimConfig& config, uint64_t seed = 0);
+
+  // Starts an episode with a start state drawn from the configured distribution.
+  void reset_episode();
+  void reseed(uint64_t seed) { rng_.reseed(seed); }
+
+  // Replaces the state (tests, traces). Referee counters restart at this state.
+  void set_state(const PlayerState& agent, const BallState& ball);
+  [[nodiscard]] const SoccerState& state() const { return state_; }
+  SoccerState& mutable_state() { return state_; }
+  [[nodiscard]] const PlayerState& agent() const { return state_.players[0]; }
+  [[nodiscard]] const SoccerSimConfig& config() const { return config_; }
+
+  // Agent commands, as the HFO agent issues them through librcsc (client-side clamping,
+  // wrapping, gating and compensation, then the server's handling). At most one per cycle;
+  // each returns false if the command was not sent or was refused (frozen, ball not kickable).
+  bool dash(double power, double dir_deg);
+  bool turn(double dir_deg);
+  bool tackle(double dir_deg);
+  bool kick(double power, double dir_deg);
+
+  // Advances one server cycle (movement, collisions, referee, stamina) and returns the status.
+  int step();
+
+  // Client kickable rule (reference §2.7): distance agent-ball <= 1.03.
+  [[nodiscard]] bool agent_kickable() const;
+
+ private:
+  void move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max, double speed_max,
+                   double rand, bool* hit_post);
+  void collide_objects();
+  int referee_server();
+  int referee_trainer();
+  void update_stamina(PlayerState& p);
+  Vec2 noise_vector(double max_radius);
+
+  SoccerSimConfig config_;
+  SoccerState state_;
+  std::array<Vec2, SoccerState::kMaxPlayers> player_accel_{};
+  Vec2 ball_accel_;
+  Rng rng_;
+  bool first_episode_ = true;
+};
+
+}  // namespace pamdp::hfo

@@ -1,0 +1,67 @@
+#include "learner/evaluation.hpp"
+
+#include <nlohmann/json.hpp>
+#include <vector>
+
+namespace pamdp {
+
+EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed) {
+  std::vector<float> obs(static_cast<size_t>(env.observation_size()));
+  std::vector<int> counts(8, 0);
+  EvalResult res;
+  res.episodes = episodes;
+  double total_return = 0.0;
+  int64_t total_steps = 0;
+  int64_t goal_steps = 0;
+  int goals = 0;
+  for (int ep = 0; ep < episodes; ++ep) {
+    if (ep == 0) {
+      env.reset(seed, obs);
+    } else {
+      env.reset(obs);
+    }
+    policy.begin_episode();
+    int steps = 0;
+    StepResult sr;
+    do {
+      sr = env.step(policy.act(obs), obs);
+      total_return += sr.reward;
+      ++steps;
+    } while (!sr.terminal());
+    total_steps += steps;
+    if (static_cast<size_t>(sr.status) >= counts.size()) {
+      counts.resize(static_cast<size_t>(sr.status) + 1, 0);
+    }
+    ++counts[static_cast<size_t>(sr.status)];
+    if (sr.status == env.success_status()) {
+      ++goals;
+      goal_steps += steps;
+    }
+  }
+  for (int s : env.outcomes()) {
+    if (s != 0) {
+      res.outcomes[std::string(env.status_name(s))] =
+          static_cast<size_t>(s) < counts.size() ? counts[static_cast<size_t>(s)] : 0;
+    }
+  }
+  if (episodes > 0) {
+    res.goal_rate = static_cast<double>(goals) / episodes;
+    res.avg_return = total_return / episodes;
+    res.avg_steps = static_cast<double>(total_steps) / episodes;
+  }
+  res.avg_steps_to_goal = goals > 0 ? static_cast<double>(goal_steps) / goals : 0.0;
+  return res;
+}
+
+std::string to_json(const EvalResult& r) {
+  nlohmann::json j;
+  j["episodes"] = r.episodes;
+  j["goal_rate"] = r.goal_rate;
+  j["avg_steps_to_goal"] = r.avg_steps_to_goal;
+  j["avg_return"] = r.avg_return;
+  j["avg_steps"] = r.avg_steps;
+  j["outcomes"] = r.outcomes;
+  return j.dump();
+}
+
+}  // namespace pamdp

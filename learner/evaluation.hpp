@@ -1,0 +1,31 @@
+// Evaluation with the paper's protocol: play N episodes with a fixed policy and report the
+// scoring rate and the average number of steps to goal (the paper's table), plus outcome
+// counts and the mean return. Allocates only at construction of its buffers.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "core/policy.hpp"
+#include "envs/env.hpp"
+
+namespace pamdp {
+
+struct EvalResult {
+  int episodes = 0;
+  double goal_rate = 0.0;          // fraction of episodes ending with env.success_status()
+  double avg_steps_to_goal = 0.0;  // over successful episodes only; 0 if none
+  double avg_return = 0.0;
+  double avg_steps = 0.0;               // over all episodes
+  std::map<std::string, int> outcomes;  // status name -> count (every outcome listed)
+};
+
+// Plays `episodes` episodes; the first reset uses `seed`, later ones continue the env's stream.
+EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed);
+
+// One JSON object (no newline) with keys episodes, goal_rate, avg_steps_to_goal, avg_return,
+// avg_steps, outcomes.
+std::string to_json(const EvalResult& r);
+
+}  // namespace pamdp
