@@ -9,5 +9,6 @@ namespace pamdp::app {
 
 void register_eval(CLI::App& app);
 void register_sim(CLI::App& app);
+void register_train(CLI::App& app);
 
 }  // namespace pamdp::app

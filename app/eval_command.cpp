@@ -3,11 +3,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/actor_policy.hpp"
 #include "app/commands.hpp"
+#include "app/env_factory.hpp"
+#include "app/experiment_config.hpp"
 #include "app/sim_options.hpp"
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "learner/checkpoint.hpp"
 #include "learner/evaluation.hpp"
 
 namespace pamdp::app {
@@ -18,10 +22,43 @@ struct EvalOptions {
   int episodes = 100;
   uint64_t seed = 1;
   bool json = false;
+  std::string checkpoint;
   SimOptions sim;
 };
 
+void print_result(const std::string& name, const EvalResult& r, bool json) {
+  std::printf("%-10s %9s %9s %18s %12s %10s\n", "policy", "episodes", "scoring", "avg steps to goal", "mean return",
+              "avg steps");
+  std::printf("%-10s %9d %9.3f %18.1f %12.3f %10.1f\n", name.c_str(), r.episodes, r.goal_rate, r.avg_steps_to_goal,
+              r.avg_return, r.avg_steps);
+  std::printf("outcomes:");
+  for (const auto& [status, count] : r.outcomes) {
+    std::printf(" %s=%d", status.c_str(), count);
+  }
+  std::printf("\n");
+  if (json) {
+    std::printf("%s\n", to_json(r).c_str());
+  }
+}
+
+// A trained actor, with the env and bounds of the run that wrote the checkpoint.
+void run_checkpoint_eval(const EvalOptions& o) {
+  ExperimentConfig c = parse_experiment_config(read_checkpoint_config(o.checkpoint), o.checkpoint + " (config)", {});
+  if (o.sim.no_noise) {
+    c.env.hfo.noise = false;
+  }
+  auto env = make_env(c.env);
+  Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
+  load_checkpoint(o.checkpoint, ddpg);
+  GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
+  print_result("ddpg", evaluate(*env, policy, o.episodes, o.seed), o.json);
+}
+
 void run_eval(const EvalOptions& o) {
+  if (!o.checkpoint.empty()) {
+    run_checkpoint_eval(o);
+    return;
+  }
   hfo::HfoEnv env(o.sim.resolved());
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {
@@ -33,20 +70,7 @@ void run_eval(const EvalOptions& o) {
     random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
     policy = std::move(random);
   }
-  const EvalResult r = evaluate(env, *policy, o.episodes, o.seed);
-
-  std::printf("%-10s %9s %9s %18s %12s %10s\n", "policy", "episodes", "scoring", "avg steps to goal", "mean return",
-              "avg steps");
-  std::printf("%-10s %9d %9.3f %18.1f %12.3f %10.1f\n", o.policy.c_str(), r.episodes, r.goal_rate, r.avg_steps_to_goal,
-              r.avg_return, r.avg_steps);
-  std::printf("outcomes:");
-  for (const auto& [name, count] : r.outcomes) {
-    std::printf(" %s=%d", name.c_str(), count);
-  }
-  std::printf("\n");
-  if (o.json) {
-    std::printf("%s\n", to_json(r).c_str());
-  }
+  print_result(o.policy, evaluate(env, *policy, o.episodes, o.seed), o.json);
 }
 
 }  // namespace
@@ -62,6 +86,9 @@ void register_eval(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", opts->seed, "random seed of the evaluation")->capture_default_str();
   cmd->add_flag("--json", opts->json, "print one JSON object as the last line");
+  cmd->add_option("--checkpoint", opts->checkpoint,
+                  "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used)")
+      ->check(CLI::ExistingFile);
   opts->sim.add_to(*cmd);
   cmd->callback([opts] { run_eval(*opts); });
 }

@@ -7,7 +7,9 @@
 #include "app/commands.hpp"
 #include "core/log.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app{"pamdp: DDPG in parameterized action spaces (Hausknecht & Stone, ICLR 2016) on Half Field Offense"};
   app.require_subcommand(1);
   std::string log_level = "info";
@@ -18,6 +20,7 @@ int main(int argc, char** argv) {
 
   pamdp::app::register_eval(app);
   pamdp::app::register_sim(app);
+  pamdp::app::register_train(app);
 
   try {
     app.parse(argc, argv);
@@ -28,4 +31,17 @@ int main(int argc, char** argv) {
     return 2;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pamdp: fatal: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "pamdp: fatal: unknown exception\n");
+  }
+  return 3;
 }

@@ -1,1 +1,281 @@
+// The `pamdp` executable as a user meets it: help, `eval --json`, flag errors, and
+// `sim trace` against a golden trace (tests/golden; refresh with tests/golden/regenerate.sh
+// after an intended physics change).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const std::string kPamdp = PAMDP_BIN_DIR "/pamdp";
+const std::string kGolden = PAMDP_TEST_DATA_DIR "/golden";
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;
+};
+
+enum class Capture { kStdoutAndStderr, kStdoutOnly };
+
+// Runs `pamdp <args>` through the shell and collects its output and exit status.
+RunResult run_pamdp(const std::string& args, Capture capture = Capture::kStdoutAndStderr) {
+  const std::string cmd =
+      "'" + kPamdp + "' " + args + (capture == Capture::kStdoutAndStderr ? " 2>&1" : " 2>/dev/null");
+  RunResult r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (pipe == nullptr) {
+    ADD_FAILURE() << "popen failed for: " << cmd;
+    return r;
+  }
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) {
+    r.output.append(buf.data(), n);
+  }
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    out.push_back(item);
+  }
+  return out;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string quoted(const std::string& path) {
+  return "'" + path + "'";
+}
+
+// A file under the test temp dir, unique per test and process (ctest runs tests in
+// parallel), removed when the test ends.
+class TempFile {
+ public:
+  TempFile(const std::string& suffix, const std::string& contents) {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string test_name = info->name();  // "Suite/Param" for parameterized tests
+    std::replace(test_name.begin(), test_name.end(), '/', '_');
+    path_ = ::testing::TempDir() + "pamdp_cli_" + test_name + "_" + std::to_string(::getpid()) + suffix;
+    std::ofstream(path_) << contents;
+  }
+  ~TempFile() { std::remove(path_.c_str()); }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+TEST(Cli, HelpListsSubcommands) {
+  const RunResult r = run_pamdp("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("eval"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("sim"), std::string::npos) << r.output;
+
+  const RunResult sim = run_pamdp("sim --help");
+  EXPECT_EQ(sim.exit_code, 0) << sim.output;
+  EXPECT_NE(sim.output.find("trace"), std::string::npos) << sim.output;
+}
+
+TEST(Cli, NoSubcommandFails) {
+  const RunResult r = run_pamdp("");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+}
+
+TEST(Cli, EvalJsonLastLineHasEveryKey) {
+  const RunResult r = run_pamdp("eval --episodes 20 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::vector<std::string> lines = split(r.output, '\n');
+  while (!lines.empty() && lines.back().empty()) {
+    lines.pop_back();
+  }
+  ASSERT_FALSE(lines.empty());
+  nlohmann::json j;
+  ASSERT_NO_THROW(j = nlohmann::json::parse(lines.back())) << "last line is not JSON: " << lines.back();
+  for (const char* key : {"episodes", "goal_rate", "avg_steps_to_goal", "avg_return", "avg_steps", "outcomes"}) {
+    EXPECT_TRUE(j.contains(key)) << key << " missing from " << lines.back();
+  }
+  EXPECT_EQ(j.value("episodes", -1), 20);
+  int total = 0;
+  for (const auto& [name, count] : j.at("outcomes").items()) {
+    total += count.get<int>();
+  }
+  EXPECT_EQ(total, 20);
+  const double rate = j.at("goal_rate").get<double>();
+  EXPECT_GE(rate, 0.0);
+  EXPECT_LE(rate, 1.0);
+}
+
+TEST(Cli, EvalIsDeterministicForAGivenSeed) {
+  const RunResult a = run_pamdp("eval --episodes 10 --policy random --seed 5 --json", Capture::kStdoutOnly);
+  const RunResult b = run_pamdp("eval --episodes 10 --policy random --seed 5 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_EQ(a.output, b.output);
+}
+
+struct BadInvocation {
+  std::string name;
+  std::string args;
+  std::vector<std::string> message_names;  // substrings the error message must contain
+};
+
+// Test names and failure messages show the case's name, not its bytes.
+void PrintTo(const BadInvocation& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class CliRejects : public ::testing::TestWithParam<BadInvocation> {};
+
+TEST_P(CliRejects, ExitsNonZeroNamingTheProblem) {
+  const RunResult r = run_pamdp(GetParam().args);
+  EXPECT_NE(r.exit_code, 0) << "pamdp " << GetParam().args << " succeeded:\n" << r.output;
+  for (const std::string& s : GetParam().message_names) {
+    EXPECT_NE(r.output.find(s), std::string::npos) << "message does not name '" << s << "':\n" << r.output;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadFlags, CliRejects,
+    ::testing::Values(BadInvocation{"NegativeEpisodes", "eval --episodes -3", {"--episodes", "-3"}},
+                      BadInvocation{"ZeroEpisodes", "eval --episodes 0", {"--episodes", "0"}},
+                      BadInvocation{"NonNumericEpisodes", "eval --episodes many", {"--episodes", "many"}},
+                      BadInvocation{"UnknownPolicy", "eval --policy foo", {"--policy", "foo"}},
+                      BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
+                      BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
+                      // CLI11 answers these two with "A subcommand is required", naming neither the
+                      // unknown word nor the valid subcommands; only the exit status is checked.
+                      BadInvocation{"UnknownSubcommand", "frobnicate", {}},
+                      BadInvocation{"SimWithoutSubcommand", "sim", {}},
+                      BadInvocation{"MissingTraceFiles",
+                                    "sim trace --init /nonexistent/state.json --actions /nonexistent/a.csv",
+                                    {"/nonexistent/state.json"}}),
+    [](const ::testing::TestParamInfo<BadInvocation>& info) { return info.param.name; });
+
+// Reads a trace CSV into its header and rows of cells.
+struct Csv {
+  std::string header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+Csv parse_csv(const std::string& text) {
+  Csv csv;
+  std::vector<std::string> lines = split(text, '\n');
+  if (lines.empty()) {
+    return csv;
+  }
+  csv.header = lines[0];
+  for (size_t i = 1; i < lines.size(); ++i) {
+    if (!lines[i].empty()) {
+      csv.rows.push_back(split(lines[i], ','));
+    }
+  }
+  return csv;
+}
+
+TEST(Cli, SimTraceMatchesGoldenTrace) {
+  // Keep these flags in step with tests/golden/regenerate.sh.
+  const RunResult r = run_pamdp("sim trace --init " + quoted(kGolden + "/kick_to_goal.state.json") + " --actions " +
+                                    quoted(kGolden + "/kick_to_goal.actions.csv") + " --no-noise",
+                                Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Csv got = parse_csv(r.output);
+  const Csv want = parse_csv(read_text(kGolden + "/kick_to_goal.trace.csv"));
+  ASSERT_FALSE(want.rows.empty()) << "golden trace is empty; run tests/golden/regenerate.sh";
+
+  const std::string hint = " (if the physics changed on purpose, run tests/golden/regenerate.sh and review the diff)";
+  ASSERT_EQ(got.header, want.header);
+  ASSERT_EQ(got.rows.size(), want.rows.size()) << "number of steps differs" << hint;
+  const std::vector<std::string> columns = split(want.header, ',');
+  constexpr double kTolerance = 1e-6;
+  int mismatches = 0;
+  for (size_t i = 0; i < want.rows.size(); ++i) {
+    const auto& g = got.rows[i];
+    const auto& w = want.rows[i];
+    ASSERT_EQ(g.size(), columns.size()) << "row " << i;
+    ASSERT_EQ(w.size(), columns.size()) << "golden row " << i;
+    EXPECT_EQ(g[0], w[0]) << "step column, row " << i;
+    EXPECT_EQ(g[1], w[1]) << "status column, row " << i << hint;
+    for (size_t c = 2; c < columns.size(); ++c) {
+      const double gv = std::stod(g[c]);
+      const double wv = std::stod(w[c]);
+      if (!(std::fabs(gv - wv) <= kTolerance) && ++mismatches <= 10) {
+        ADD_FAILURE() << "step " << w[0] << " column " << columns[c] << ": got " << g[c] << ", golden " << w[c] << hint;
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+struct MalformedInput {
+  std::string name;
+  bool is_state;  // the bad file is STATE.json (else ACTIONS.csv)
+  std::string contents;
+  std::vector<std::string> message_names;  // besides the file path
+};
+
+// Test names and failure messages show the case's name, not its bytes.
+void PrintTo(const MalformedInput& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class CliRejectsMalformedInput : public ::testing::TestWithParam<MalformedInput> {};
+
+TEST_P(CliRejectsMalformedInput, NamesFileAndProblem) {
+  const MalformedInput& c = GetParam();
+  const TempFile bad(c.is_state ? ".json" : ".csv", c.contents);
+  const std::string state = c.is_state ? bad.path() : kGolden + "/kick_to_goal.state.json";
+  const std::string actions = c.is_state ? kGolden + "/kick_to_goal.actions.csv" : bad.path();
+  const RunResult r = run_pamdp("sim trace --no-noise --init " + quoted(state) + " --actions " + quoted(actions));
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(bad.path()), std::string::npos) << "message does not name the file:\n" << r.output;
+  for (const std::string& s : c.message_names) {
+    EXPECT_NE(r.output.find(s), std::string::npos) << "message does not name '" << s << "':\n" << r.output;
+  }
+  EXPECT_EQ(r.output.find("step,status"), std::string::npos) << "a trace was printed despite the error";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadFiles, CliRejectsMalformedInput,
+    ::testing::Values(
+        MalformedInput{"StateSyntaxError",
+                       true,
+                       "{\n  \"agent\": {\"x\": 1, \"y\": 2},\n  \"ball\": {\"x\": 3 \"y\": 4}\n}\n",
+                       {"line 3"}},
+        MalformedInput{"StateMissingKey", true, "{\"agent\": {\"x\": 1}, \"ball\": {\"x\": 3, \"y\": 4}}", {"agent.y"}},
+        MalformedInput{"StateUnknownKey",
+                       true,
+                       "{\"agent\": {\"x\": 1, \"y\": 2, \"z\": 0}, \"ball\": {\"x\": 3, \"y\": 4}}",
+                       {"agent.z"}},
+        MalformedInput{"StateNotANumber",
+                       true,
+                       "{\"agent\": {\"x\": \"one\", \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}}",
+                       {"agent.x"}},
+        MalformedInput{"ActionsUnknownAction", false, "DASH,100,0\n# comment\nJUMP,1\n", {":3:", "JUMP"}},
+        MalformedInput{"ActionsWrongArity", false, "DASH,100,0\n\nTURN,10\nKICK,100\n", {":4:", "KICK,power,dir"}},
+        MalformedInput{"ActionsNotANumber", false, "DASH,fast,0\n", {":1:", "fast"}}),
+    [](const ::testing::TestParamInfo<MalformedInput>& info) { return info.param.name; });
+
+}  // namespace

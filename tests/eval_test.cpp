@@ -1,1 +1,146 @@
+// evaluate() and to_json() (learner/evaluation.hpp): the scripted HFO baseline scores as the
+// paper's Helios stand-in must, and the counts and the JSON are consistent by construction.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/policy.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/scripted_offense.hpp"
+#include "envs/toy/reach_stop.hpp"
+#include "learner/evaluation.hpp"
+
+namespace pamdp {
+namespace {
+
+// Invariants of any EvalResult, whatever the policy.
+void expect_consistent(const EvalResult& r, const Env& env, int episodes) {
+  EXPECT_EQ(r.episodes, episodes);
+  int total = 0;
+  for (const auto& [name, count] : r.outcomes) {
+    EXPECT_GE(count, 0) << name;
+    total += count;
+  }
+  EXPECT_EQ(total, episodes) << "outcome counts must sum to the episode count";
+
+  // Every terminal outcome is listed (with 0 if it never happened), and nothing else.
+  int terminal_outcomes = 0;
+  for (int s : env.outcomes()) {
+    if (s != 0) {
+      ++terminal_outcomes;
+      EXPECT_TRUE(r.outcomes.contains(std::string(env.status_name(s)))) << env.status_name(s);
+    }
+  }
+  EXPECT_EQ(static_cast<int>(r.outcomes.size()), terminal_outcomes);
+
+  const int goals = r.outcomes.at(std::string(env.status_name(env.success_status())));
+  EXPECT_DOUBLE_EQ(r.goal_rate, static_cast<double>(goals) / episodes);
+  EXPECT_GE(r.avg_steps, 1.0);
+  EXPECT_LE(r.avg_steps, env.max_episode_steps());
+  if (goals == 0) {
+    EXPECT_EQ(r.avg_steps_to_goal, 0.0);
+  } else {
+    EXPECT_GE(r.avg_steps_to_goal, 1.0);
+    EXPECT_LE(r.avg_steps_to_goal, env.max_episode_steps());
+  }
+  if (goals == episodes) {
+    EXPECT_DOUBLE_EQ(r.avg_steps_to_goal, r.avg_steps);
+  }
+  EXPECT_TRUE(std::isfinite(r.avg_return));
+}
+
+TEST(Evaluate, ScriptedOffenseScoresAtLeast95PercentWithNoise) {
+  hfo::SoccerSimConfig config;  // paper start distribution, server referee
+  config.noise = true;
+  ASSERT_EQ(config.start, hfo::StartDistribution::kPaper);
+  hfo::HfoEnv env(config);
+  hfo::ScriptedOffense policy;
+  constexpr int kEpisodes = 300;
+  const EvalResult r = evaluate(env, policy, kEpisodes, 20160101);
+  expect_consistent(r, env, kEpisodes);
+  EXPECT_GE(r.goal_rate, 0.95) << to_json(r);
+  // The shaped reward pays 5 for a goal; a scorer's mean return must be clearly positive.
+  EXPECT_GT(r.avg_return, 0.0) << to_json(r);
+}
+
+TEST(Evaluate, RandomPolicyCountsAreConsistent) {
+  hfo::HfoEnv env;
+  RandomPolicy policy(env.action_space(), 5, {hfo::kDash, hfo::kTurn, hfo::kKick});
+  policy.set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
+  constexpr int kEpisodes = 50;
+  const EvalResult r = evaluate(env, policy, kEpisodes, 7);
+  expect_consistent(r, env, kEpisodes);
+}
+
+TEST(Evaluate, SameSeedGivesSameResult) {
+  hfo::HfoEnv env_a;
+  hfo::HfoEnv env_b;
+  hfo::ScriptedOffense policy_a;
+  hfo::ScriptedOffense policy_b;
+  const EvalResult a = evaluate(env_a, policy_a, 30, 42);
+  const EvalResult b = evaluate(env_b, policy_b, 30, 42);
+  EXPECT_EQ(to_json(a), to_json(b));
+}
+
+// An oracle for ReachStop: move straight at the target, stop once within tolerance.
+class ReachStopOracle final : public Policy {
+ public:
+  explicit ReachStopOracle(const toy::ReachStopConfig& c) : config_(c) {}
+  ParamAction act(std::span<const float> obs) override {
+    const float gap = obs[2];
+    if (std::fabs(gap) <= 0.5F * config_.tolerance) {
+      return {toy::ReachStopEnv::kStop, params_};
+    }
+    params_[0] = std::clamp(gap / config_.max_step, -1.0F, 1.0F);
+    return {toy::ReachStopEnv::kMove, params_};
+  }
+
+ private:
+  toy::ReachStopConfig config_;
+  std::array<float, 1> params_{};
+};
+
+TEST(Evaluate, ReachStopOracleAlwaysSucceeds) {
+  const toy::ReachStopConfig config;
+  toy::ReachStopEnv env(config);
+  ReachStopOracle oracle(config);
+  constexpr int kEpisodes = 500;
+  const EvalResult r = evaluate(env, oracle, kEpisodes, 3);
+  expect_consistent(r, env, kEpisodes);
+  EXPECT_EQ(r.goal_rate, 1.0) << to_json(r);
+  // At most ceil(2 / max_step) moves plus the stop.
+  EXPECT_LE(r.avg_steps_to_goal, 2.0F / config.max_step + 1.0F);
+  // Return = initial distance - final distance + bonus; with E|pos - target| = 2/3 the mean is
+  // about 1.67 (tolerance covers sampling error of 500 episodes, sd ~0.5 / sqrt(500)).
+  EXPECT_NEAR(r.avg_return, config.success_bonus + 2.0 / 3.0, 0.1) << to_json(r);
+}
+
+TEST(ToJson, ParsesBackWithEveryKeyAndValue) {
+  hfo::HfoEnv env;
+  hfo::ScriptedOffense policy;
+  const EvalResult r = evaluate(env, policy, 20, 9);
+  const std::string text = to_json(r);
+  EXPECT_EQ(text.find('\n'), std::string::npos) << "to_json must be one line";
+
+  const nlohmann::json j = nlohmann::json::parse(text);
+  ASSERT_TRUE(j.is_object());
+  for (const char* key : {"episodes", "goal_rate", "avg_steps_to_goal", "avg_return", "avg_steps", "outcomes"}) {
+    EXPECT_TRUE(j.contains(key)) << key << " missing from " << text;
+  }
+  EXPECT_EQ(j.at("episodes").get<int>(), r.episodes);
+  EXPECT_DOUBLE_EQ(j.at("goal_rate").get<double>(), r.goal_rate);
+  EXPECT_DOUBLE_EQ(j.at("avg_steps_to_goal").get<double>(), r.avg_steps_to_goal);
+  EXPECT_DOUBLE_EQ(j.at("avg_return").get<double>(), r.avg_return);
+  EXPECT_DOUBLE_EQ(j.at("avg_steps").get<double>(), r.avg_steps);
+  ASSERT_TRUE(j.at("outcomes").is_object());
+  const auto outcomes = j.at("outcomes").get<std::map<std::string, int>>();
+  EXPECT_EQ(outcomes, r.outcomes);
+}
+
+}  // namespace
+}  // namespace pamdp

@@ -1,5 +1,5 @@
 // Replays every single-step transition recorded from the real HFO server (noise off,
-// shared/data/hfo-real-transitions.csv) through SoccerSim and compares the next state.
+// tests/data/hfo-real-transitions.csv, a copy of shared/data) through SoccerSim and compares the next state.
 // Requirement: >= 99% of rows within 0.01 m, 0.01 m/cycle and 0.5 deg. A faithful
 // implementation of the reference gets all of them, so the test also reports every miss.
 #include <gtest/gtest.h>
@@ -121,8 +121,8 @@ Errors replay(const Row& r, uint64_t seed) {
 }
 
 TEST(HfoRealData, ReplaysRealServerTransitions) {
-  const std::vector<Row> rows = load_rows(std::string(PAMDP_SHARED_DATA_DIR) + "/hfo-real-transitions.csv");
-  ASSERT_GT(rows.size(), 1000U) << "shared/data/hfo-real-transitions.csv not found beside the project";
+  const std::vector<Row> rows = load_rows(std::string(PAMDP_REAL_DATA_DIR) + "/hfo-real-transitions.csv");
+  ASSERT_GT(rows.size(), 1000U) << "tests/data/hfo-real-transitions.csv is missing or truncated";
 
   std::map<std::string, std::pair<int, int>> per_kind;  // kind -> (rows, misses)
   int misses = 0;

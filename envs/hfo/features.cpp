@@ -111,7 +111,7 @@ void write_features(const SoccerState& state, std::span<float> out) {
     return (pa.pos - p).r2() < (pc.pos - p).r2();
   });
   float* block = f + kNumAgentFeatures;
-  std::fill(block, block + kFeaturesPerPlayer * others, 0.0F);
+  std::fill(block, block + static_cast<ptrdiff_t>(kFeaturesPerPlayer) * others, 0.0F);
   int teammates = 0;
   for (int i = 1; i < state.num_players; ++i) {
     teammates += state.players[i].team == my_team ? 1 : 0;
@@ -125,7 +125,7 @@ void write_features(const SoccerState& state, std::span<float> out) {
     }
     const bool mate = o.team == my_team;
     const int slot = mate ? written_team++ : teammates + written_opp++;
-    float* q = block + kFeaturesPerPlayer * slot;
+    float* q = block + static_cast<ptrdiff_t>(kFeaturesPerPlayer) * slot;
     landmark(p, b, o.pos, R, q);
     const double ob = o.body_deg * kDegToRad;
     q[3] = static_cast<float>(std::sin(ob));

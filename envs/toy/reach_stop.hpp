@@ -31,10 +31,10 @@
 namespace pamdp::toy {
 
 struct ReachStopConfig {
-  int max_steps = 20;           // decisions before OUT_OF_TIME
-  float max_step = 0.25F;       // distance one MOVE with |velocity| = 1 covers
-  float tolerance = 0.1F;       // |target - pos| at which STOP counts as SUCCESS
-  float success_bonus = 1.0F;   // reward added on SUCCESS
+  int max_steps = 20;          // decisions before OUT_OF_TIME
+  float max_step = 0.25F;      // distance one MOVE with |velocity| = 1 covers
+  float tolerance = 0.1F;      // |target - pos| at which STOP counts as SUCCESS
+  float success_bonus = 1.0F;  // reward added on SUCCESS
 };
 
 class ReachStopEnv final : public Env {

@@ -1,0 +1,76 @@
+#include "actor/exploration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace pamdp {
+
+double linear_epsilon(int64_t updates, double start, double end, int64_t anneal) {
+  if (anneal <= 0 || updates >= anneal) {
+    return end;
+  }
+  const double frac = static_cast<double>(std::max<int64_t>(updates, 0)) / static_cast<double>(anneal);
+  return start + (end - start) * frac;
+}
+
+double apex_epsilon(int actor_index, int num_actors, double base, double alpha) {
+  if (num_actors <= 1) {
+    return base;
+  }
+  return std::pow(base, 1.0 + alpha * actor_index / static_cast<double>(num_actors - 1));
+}
+
+EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& config, uint64_t seed)
+    : num_actions_(space.num_actions()), masked_(static_cast<size_t>(space.num_actions()), false), rng_(seed) {
+  for (int a : config.masked_actions) {
+    if (a < 0 || a >= num_actions_) {
+      throw std::invalid_argument("exploration: masked action id out of range");
+    }
+    masked_[static_cast<size_t>(a)] = true;
+  }
+  if (std::all_of(masked_.begin(), masked_.end(), [](bool m) { return m; })) {
+    throw std::invalid_argument("exploration: every action is masked");
+  }
+  for (const ParamSpec& p : space.params) {
+    lo_.push_back(p.lo);
+    hi_.push_back(p.hi);
+  }
+  if (!config.random_param_lo.empty()) {
+    if (config.random_param_lo.size() != lo_.size() || config.random_param_hi.size() != hi_.size()) {
+      throw std::invalid_argument("exploration: random parameter ranges must list every parameter");
+    }
+    lo_ = config.random_param_lo;
+    hi_ = config.random_param_hi;
+  }
+}
+
+int EpsilonGreedy::greedy(std::span<const float> output) const {
+  int best = -1;
+  float best_score = -std::numeric_limits<float>::infinity();
+  for (int a = 0; a < num_actions_; ++a) {
+    const float s = output[static_cast<size_t>(a)];
+    if (!masked_[static_cast<size_t>(a)] && (best < 0 || s > best_score)) {
+      best = a;
+      best_score = s;
+    }
+  }
+  return best;
+}
+
+int EpsilonGreedy::select(std::span<const float> net_output, double epsilon, std::span<float> stored) {
+  if (epsilon > 0.0 && rng_.uniform() < epsilon) {
+    for (int a = 0; a < num_actions_; ++a) {
+      stored[static_cast<size_t>(a)] = static_cast<float>(rng_.uniform(-1.0, 1.0));
+    }
+    for (size_t i = 0; i < lo_.size(); ++i) {
+      stored[static_cast<size_t>(num_actions_) + i] = static_cast<float>(rng_.uniform(lo_[i], hi_[i]));
+    }
+  } else {
+    std::copy(net_output.begin(), net_output.end(), stored.begin());
+  }
+  return greedy(stored);
+}
+
+}  // namespace pamdp

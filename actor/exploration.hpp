@@ -1,0 +1,60 @@
+// Acting in a parameterized action space (paper §4.1, reference §7.3).
+//
+// Greedy: the discrete action is the arg-max of the scores over the allowed actions (Tackle is
+// masked by default in HFO, as in the paper's code); its parameters are read from the output
+// vector unclipped (the env clamps and wraps them).
+// ε-greedy: with probability ε the whole output vector is replaced by a random one (scores
+// U[-1, 1], each parameter uniform in its exploration range), and the stored transition
+// carries that random vector.
+// select() allocates nothing; not thread-safe (one per actor thread).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/action_space.hpp"
+#include "core/rng.hpp"
+
+namespace pamdp {
+
+struct ExplorationConfig {
+  double epsilon_start = 1.0;
+  double epsilon_end = 0.1;
+  int64_t epsilon_anneal_updates = 10000;  // paper: 10,000 updates
+  std::vector<int> masked_actions;         // never executed (HFO: Tackle)
+  // Sampling range of each parameter for random actions; empty = the action space's bounds.
+  std::vector<float> random_param_lo;
+  std::vector<float> random_param_hi;
+};
+
+// Linear from start to end over `anneal` learner updates, then constant.
+double linear_epsilon(int64_t updates, double start, double end, int64_t anneal);
+// Ape-X per-actor fixed epsilon: eps_i = base^(1 + alpha * i / (N - 1)) (eps = base for N = 1).
+double apex_epsilon(int actor_index, int num_actors, double base = 0.4, double alpha = 7.0);
+
+class EpsilonGreedy {
+ public:
+  EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& config, uint64_t seed);
+
+  // Picks the action for this step. `net_output` is the actor's output vector (scores then
+  // params); `stored` receives the vector to store in replay (net_output or the random draw).
+  // Returns the chosen discrete action id; its parameters are `stored` minus the scores.
+  int select(std::span<const float> net_output, double epsilon, std::span<float> stored);
+
+  // Arg-max of the scores over unmasked actions.
+  [[nodiscard]] int greedy(std::span<const float> output) const;
+  // Offset of the parameters inside an output vector.
+  [[nodiscard]] int num_actions() const { return num_actions_; }
+
+  Rng& rng() { return rng_; }
+
+ private:
+  int num_actions_;
+  std::vector<bool> masked_;
+  std::vector<float> lo_;
+  std::vector<float> hi_;
+  Rng rng_;
+};
+
+}  // namespace pamdp

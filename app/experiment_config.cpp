@@ -1,0 +1,409 @@
+#include "app/experiment_config.hpp"
+
+#include <toml++/toml.h>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace pamdp::app {
+namespace {
+
+template <typename E>
+using Choices = std::vector<std::pair<std::string, E>>;
+
+const Choices<hfo::StartDistribution> kStarts{{"paper", hfo::StartDistribution::kPaper},
+                                              {"dec2015", hfo::StartDistribution::kDec2015},
+                                              {"hfo", hfo::StartDistribution::kHfo}};
+const Choices<hfo::Referee> kReferees{{"server", hfo::Referee::kServer}, {"trainer", hfo::Referee::kTrainer}};
+const Choices<hfo::BodyAtReset> kBodies{
+    {"carry", hfo::BodyAtReset::kCarry}, {"zero", hfo::BodyAtReset::kZero}, {"uniform", hfo::BodyAtReset::kUniform}};
+const Choices<BoundMethod> kBounds{
+    {"inverting", BoundMethod::kInverting}, {"zeroing", BoundMethod::kZeroing}, {"squashing", BoundMethod::kSquashing}};
+const Choices<std::string> kEnvs{{"hfo", "hfo"}, {"reach_stop", "reach_stop"}};
+
+// Splits "a.b.c" into {"a", "b", "c"}.
+std::vector<std::string> split_path(const std::string& key) {
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  std::string p;
+  while (std::getline(ss, p, '.')) {
+    parts.push_back(p);
+  }
+  return parts;
+}
+
+// Every field of the config is listed once, in visit(); the reader and the writer below are the
+// two visitors, so the file format and the struct cannot drift apart.
+template <typename V>
+void visit(V& v, ExperimentConfig& c) {
+  v.integer("seed", c.seed, 0, INT64_MAX);
+  v.choice("env.name", c.env.name, kEnvs);
+  v.boolean("env.noise", c.env.hfo.noise);
+  v.choice("env.start", c.env.hfo.start, kStarts);
+  v.choice("env.referee", c.env.hfo.referee, kReferees);
+  v.choice("env.body_at_reset", c.env.hfo.body_at_reset, kBodies);
+  v.integer("env.max_steps", c.env.hfo.max_steps, 1, 1000000);
+  v.integer("env.untouched_limit", c.env.hfo.untouched_limit, 1, 1000000);
+
+  v.int_list("ddpg.hidden", c.ddpg.hidden, 1, 1 << 16);
+  v.real("ddpg.actor_learning_rate", c.ddpg.actor_learning_rate, 0.0, 1.0);
+  v.real("ddpg.critic_learning_rate", c.ddpg.critic_learning_rate, 0.0, 1.0);
+  v.real("ddpg.adam_beta1", c.ddpg.adam_beta1, 0.0, 0.999999);
+  v.real("ddpg.adam_beta2", c.ddpg.adam_beta2, 0.0, 0.999999999);
+  v.real("ddpg.adam_epsilon", c.ddpg.adam_epsilon, 0.0, 1.0);
+  v.real("ddpg.gamma", c.ddpg.gamma, 0.0, 1.0);
+  v.real("ddpg.tau", c.ddpg.tau, 0.0, 1.0);
+  v.integer("ddpg.batch_size", c.ddpg.batch_size, 1, 65536);
+  v.real("ddpg.clip_grad_norm", c.ddpg.clip_grad_norm, 0.0, 1e12);
+  v.choice("ddpg.bound", c.ddpg.bound, kBounds);
+  v.real("ddpg.mc_mix", c.ddpg.mc_mix, 0.0, 1.0);
+  v.real("ddpg.init_std", c.ddpg.init_std, 0.0, 10.0);
+  v.real("ddpg.critic_output_init_std", c.ddpg.critic_output_init_std, 0.0, 10.0);
+  v.real("ddpg.critic_output_init_bias", c.ddpg.critic_output_init_bias, -1e6, 1e6);
+
+  v.real("exploration.epsilon_start", c.exploration.epsilon_start, 0.0, 1.0);
+  v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);
+  v.integer("exploration.epsilon_anneal_updates", c.exploration.epsilon_anneal_updates, 0, INT64_MAX);
+  v.str_list("exploration.masked_actions", c.masked_actions);
+  v.ranges("exploration.random_param_ranges", c.random_param_ranges);
+
+  v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
+  v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
+
+  v.integer("train.max_updates", c.train.max_updates, 0, INT64_MAX);
+  v.integer("train.max_episodes", c.train.max_episodes, 0, INT64_MAX);
+  v.real("train.max_seconds", c.train.max_seconds, 0.0, 1e9);
+  v.real("train.updates_per_step", c.train.updates_per_step, 0.0, 1000.0);
+  v.integer("train.eval_every_updates", c.train.eval_every_updates, 0, INT64_MAX);
+  v.integer("train.eval_episodes", c.train.eval_episodes, 0, 1000000);
+  v.real("train.checkpoint_every_seconds", c.train.checkpoint_every_seconds, 0.0, 1e9);
+  v.real("train.log_every_seconds", c.train.log_every_seconds, 0.0, 1e9);
+}
+
+class Reader {
+ public:
+  Reader(const toml::table& root, std::string source) : root_(root), source_(std::move(source)) {}
+
+  template <typename T>
+  void integer(const std::string& key, T& out, int64_t lo, int64_t hi) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value_exact<int64_t>();
+      if (!v) {
+        fail(key, "must be an integer");
+      }
+      if (*v < lo || *v > hi) {
+        fail(key, "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(*v));
+      }
+      out = static_cast<T>(*v);
+    }
+  }
+  void real(const std::string& key, double& out, double lo, double hi) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value<double>();  // accepts integers too
+      if (!v || n->is_boolean()) {
+        fail(key, "must be a number");
+      }
+      if (!(*v >= lo && *v <= hi)) {
+        std::ostringstream ss;
+        ss << "must be within [" << lo << ", " << hi << "], got " << *v;
+        fail(key, ss.str());
+      }
+      out = *v;
+    }
+  }
+  void boolean(const std::string& key, bool& out) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value_exact<bool>();
+      if (!v) {
+        fail(key, "must be true or false");
+      }
+      out = *v;
+    }
+  }
+  template <typename E>
+  void choice(const std::string& key, E& out, const Choices<E>& choices) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value_exact<std::string>();
+      std::string valid;
+      for (const auto& [name, value] : choices) {
+        valid += (valid.empty() ? "" : ", ") + name;
+        if (v && *v == name) {
+          out = value;
+          return;
+        }
+      }
+      fail(key, "must be one of: " + valid);
+    }
+  }
+  void int_list(const std::string& key, std::vector<int>& out, int lo, int hi) {
+    if (const toml::node* n = find(key)) {
+      const toml::array* arr = n->as_array();
+      if (arr == nullptr || arr->empty()) {
+        fail(key, "must be a non-empty array of integers, e.g. [1024, 512, 256, 128]");
+      }
+      std::vector<int> values;
+      for (const auto& e : *arr) {
+        const auto v = e.value_exact<int64_t>();
+        if (!v || *v < lo || *v > hi) {
+          fail(key, "entries must be integers within [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        }
+        values.push_back(static_cast<int>(*v));
+      }
+      out = values;
+    }
+  }
+  void str_list(const std::string& key, std::vector<std::string>& out) {
+    if (const toml::node* n = find(key)) {
+      const toml::array* arr = n->as_array();
+      if (arr == nullptr) {
+        fail(key, "must be an array of strings");
+      }
+      std::vector<std::string> values;
+      for (const auto& e : *arr) {
+        const auto v = e.value_exact<std::string>();
+        if (!v) {
+          fail(key, "must be an array of strings");
+        }
+        values.push_back(*v);
+      }
+      out = values;
+    }
+  }
+  void ranges(const std::string& key, std::vector<std::pair<std::string, std::pair<float, float>>>& out) {
+    const toml::node* n = find(key, /*leaf=*/false);
+    if (n == nullptr) {
+      return;
+    }
+    const toml::table* t = n->as_table();
+    if (t == nullptr) {
+      fail(key, "must be a table of name = [lo, hi]");
+    }
+    out.clear();
+    for (const auto& [name, value] : *t) {
+      const toml::array* arr = value.as_array();
+      if (arr == nullptr || arr->size() != 2 || !(*arr)[0].value<double>() || !(*arr)[1].value<double>()) {
+        fail(key + "." + std::string(name.str()), "must be [lo, hi]");
+      }
+      const double lo = *(*arr)[0].value<double>();
+      const double hi = *(*arr)[1].value<double>();
+      if (!(lo < hi)) {
+        fail(key + "." + std::string(name.str()), "needs lo < hi");
+      }
+      out.emplace_back(std::string(name.str()), std::make_pair(static_cast<float>(lo), static_cast<float>(hi)));
+    }
+  }
+
+  // Any key in the file that no field read is an error naming its section's valid keys.
+  void reject_unknown() const { check_table(root_, ""); }
+
+ private:
+  const toml::node* find(const std::string& key, bool leaf = true) {
+    known_.insert(key);
+    const toml::node* node = &root_;
+    for (const std::string& part : split_path(key)) {
+      const toml::table* t = node->as_table();
+      if (t == nullptr) {
+        return nullptr;
+      }
+      node = t->get(part);
+      if (node == nullptr) {
+        return nullptr;
+      }
+    }
+    if (leaf && node->is_table()) {
+      fail(key, "must be a value, not a table");
+    }
+    return node;
+  }
+
+  void check_table(const toml::table& t, const std::string& prefix) const {
+    for (const auto& [k, v] : t) {
+      const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (known_.count(key) != 0) {
+        continue;
+      }
+      if (v.is_table() && is_section(key)) {
+        check_table(*v.as_table(), key);
+        continue;
+      }
+      // Valid names in this section: known keys and sub-sections directly under `prefix`.
+      std::set<std::string> valid;
+      for (const std::string& kk : known_) {
+        if (!prefix.empty() && kk.rfind(prefix + ".", 0) != 0) {
+          continue;
+        }
+        const std::string rest = prefix.empty() ? kk : kk.substr(prefix.size() + 1);
+        const auto dot = rest.find('.');
+        valid.insert(dot == std::string::npos ? rest : "[" + rest.substr(0, dot) + "]");
+      }
+      std::string list;
+      for (const auto& name : valid) {
+        list += (list.empty() ? "" : ", ") + name;
+      }
+      throw std::runtime_error(source_ + ": unknown key '" + key + "' (valid" +
+                               (prefix.empty() ? std::string() : " in [" + prefix + "]") + ": " + list + ")");
+    }
+  }
+  [[nodiscard]] bool is_section(const std::string& key) const {
+    for (const std::string& kk : known_) {
+      if (kk.rfind(key + ".", 0) == 0) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw std::runtime_error(source_ + ": '" + key + "' " + what);
+  }
+
+  const toml::table& root_;
+  std::string source_;
+  std::set<std::string> known_;
+};
+
+class Writer {
+ public:
+  template <typename T>
+  void integer(const std::string& key, const T& v, int64_t /*lo*/, int64_t /*hi*/) {
+    put(key, static_cast<int64_t>(v));
+  }
+  void real(const std::string& key, const double& v, double /*lo*/, double /*hi*/) { put(key, v); }
+  void boolean(const std::string& key, const bool& v) { put(key, v); }
+  template <typename E>
+  void choice(const std::string& key, const E& v, const Choices<E>& choices) {
+    for (const auto& [name, value] : choices) {
+      if (value == v) {
+        put(key, name);
+      }
+    }
+  }
+  void int_list(const std::string& key, const std::vector<int>& v, int /*lo*/, int /*hi*/) {
+    toml::array arr;
+    for (int x : v) {
+      arr.push_back(static_cast<int64_t>(x));
+    }
+    put(key, std::move(arr));
+  }
+  void str_list(const std::string& key, const std::vector<std::string>& v) {
+    toml::array arr;
+    for (const auto& s : v) {
+      arr.push_back(s);
+    }
+    put(key, std::move(arr));
+  }
+  void ranges(const std::string& key, const std::vector<std::pair<std::string, std::pair<float, float>>>& v) {
+    toml::table t;
+    for (const auto& [name, r] : v) {
+      t.insert(name, toml::array{static_cast<double>(r.first), static_cast<double>(r.second)});
+    }
+    put(key, std::move(t));
+  }
+  toml::table root;
+
+ private:
+  template <typename T>
+  void put(const std::string& key, T&& value) {
+    const auto parts = split_path(key);
+    toml::table* t = &root;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      auto [it, inserted] = t->insert(parts[i], toml::table{});
+      t = it->second.as_table();
+    }
+    t->insert_or_assign(parts.back(), std::forward<T>(value));
+  }
+};
+
+// Applies "a.b=value": the value is parsed as a TOML value (numbers, true/false, "strings",
+// [arrays]); a bare word that is not valid TOML is taken as a string.
+void apply_override(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw std::runtime_error("--set '" + assignment + "': expected key=value, e.g. --set ddpg.gamma=0.95");
+  }
+  std::string key = assignment.substr(0, eq);
+  const std::string value = assignment.substr(eq + 1);
+  while (!key.empty() && key.back() == ' ') {
+    key.pop_back();
+  }
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    try {
+      parsed = toml::parse("v = \"" + value + "\"");
+    } catch (const toml::parse_error&) {
+      throw std::runtime_error("--set '" + assignment + "': cannot parse the value");
+    }
+  }
+  const auto parts = split_path(key);
+  toml::table* t = &root;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    auto [it, inserted] = t->insert(parts[i], toml::table{});
+    t = it->second.as_table();
+    if (t == nullptr) {
+      throw std::runtime_error("--set '" + assignment + "': '" + parts[i] + "' is not a section");
+    }
+  }
+  t->insert_or_assign(parts.back(), *parsed.get("v"));
+}
+
+void validate(const ExperimentConfig& c, const std::string& src) {
+  if (c.exploration.epsilon_end > c.exploration.epsilon_start) {
+    throw std::runtime_error(src + ": exploration.epsilon_end must not exceed exploration.epsilon_start");
+  }
+  if (c.replay.warmup > c.replay.capacity) {
+    throw std::runtime_error(src + ": replay.warmup must not exceed replay.capacity");
+  }
+  if (c.replay.warmup < c.ddpg.batch_size) {
+    throw std::runtime_error(src + ": replay.warmup must be at least ddpg.batch_size");
+  }
+}
+
+}  // namespace
+
+ExperimentConfig parse_experiment_config(const std::string& toml_text, const std::string& source_name,
+                                         const std::vector<std::string>& overrides) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, source_name);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream ss;
+    ss << source_name << ":" << e.source().begin.line << ": not valid TOML: " << e.description();
+    throw std::runtime_error(ss.str());
+  }
+  for (const auto& o : overrides) {
+    apply_override(root, o);
+  }
+  ExperimentConfig c;
+  Reader reader(root, source_name);
+  visit(reader, c);
+  reader.reject_unknown();
+  validate(c, source_name);
+  return c;
+}
+
+ExperimentConfig load_experiment_config(const std::string& path, const std::vector<std::string>& overrides) {
+  if (path.empty()) {
+    return parse_experiment_config("", "defaults", overrides);
+  }
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error("cannot open config '" + path + "': check the path (presets: deploy/configs/*.toml)");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_experiment_config(ss.str(), path, overrides);
+}
+
+std::string to_toml(const ExperimentConfig& config) {
+  Writer w;
+  visit(w, const_cast<ExperimentConfig&>(config));
+  std::ostringstream ss;
+  ss << w.root << "\n";
+  return ss.str();
+}
+
+}  // namespace pamdp::app

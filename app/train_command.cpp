@@ -1,0 +1,113 @@
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "app/experiment_config.hpp"
+#include "app/trainer.hpp"
+
+namespace pamdp::app {
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_signal(int /*sig*/) {
+  g_stop.store(true);
+}
+
+struct TrainCliOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  int64_t seed = -1;
+  std::string run_dir;
+  std::string resume;
+  bool quiet = false;
+  bool json = false;
+};
+
+std::string default_run_dir(uint64_t seed) {
+  const std::time_t t = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&t));
+  return "runs/" + std::string(stamp) + "-seed" + std::to_string(seed);
+}
+
+void run_train(const TrainCliOptions& o) {
+  namespace fs = std::filesystem;
+  TrainOptions opts;
+  ExperimentConfig config;
+  if (!o.resume.empty()) {
+    if (!o.config.empty()) {
+      throw std::runtime_error(
+          "--resume uses the config saved in the run directory; drop --config (use --set to change limits)");
+    }
+    const fs::path cfg = fs::path(o.resume) / "config.toml";
+    if (!fs::exists(cfg) || !fs::exists(fs::path(o.resume) / "checkpoint.ckpt")) {
+      throw std::runtime_error(
+          "--resume " + o.resume +
+          ": no config.toml and checkpoint.ckpt there; pass the run directory of an earlier pamdp train");
+    }
+    config = load_experiment_config(cfg.string(), o.sets);
+    opts.run_dir = o.resume;
+    opts.resume = true;
+  } else {
+    config = load_experiment_config(o.config, o.sets);
+    if (o.seed >= 0) {
+      config.seed = static_cast<uint64_t>(o.seed);
+    }
+    opts.run_dir = o.run_dir.empty() ? default_run_dir(config.seed) : o.run_dir;
+    if (fs::exists(fs::path(opts.run_dir) / "checkpoint.ckpt")) {
+      throw std::runtime_error("run directory '" + opts.run_dir + "' already holds a run; continue it with --resume " +
+                               opts.run_dir + " or choose another --run-dir");
+    }
+  }
+  opts.quiet = o.quiet;
+  opts.stop = &g_stop;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  if (!o.quiet) {
+    std::printf("pamdp train: env %s, bound %s, seed %llu, run directory %s%s\n", config.env.name.c_str(),
+                bound_method_name(config.ddpg.bound), static_cast<unsigned long long>(config.seed),
+                opts.run_dir.c_str(), opts.resume ? " (resumed)" : "");
+    std::fflush(stdout);
+  }
+  const TrainSummary s = train(config, opts);
+  std::printf(
+      "done: %lld updates, %lld episodes, %lld env steps in %.1f s; greedy eval %d episodes: success %.3f, "
+      "avg steps to success %.1f, return %.3f; checkpoint %s/checkpoint.ckpt\n",
+      static_cast<long long>(s.updates), static_cast<long long>(s.episodes), static_cast<long long>(s.env_steps),
+      s.seconds, s.final_eval.episodes, s.final_eval.goal_rate, s.final_eval.avg_steps_to_goal, s.final_eval.avg_return,
+      opts.run_dir.c_str());
+  if (o.json) {
+    std::printf(
+        "{\"run_dir\":\"%s\",\"updates\":%lld,\"episodes\":%lld,\"env_steps\":%lld,\"seconds\":%.3f,\"eval\":%s}\n",
+        opts.run_dir.c_str(), static_cast<long long>(s.updates), static_cast<long long>(s.episodes),
+        static_cast<long long>(s.env_steps), s.seconds, to_json(s.final_eval).c_str());
+  }
+}
+
+}  // namespace
+
+void register_train(CLI::App& app) {
+  auto o = std::make_shared<TrainCliOptions>();
+  CLI::App* cmd = app.add_subcommand("train", "train DDPG in one process (env, replay and learner in one thread)");
+  cmd->add_option(
+      "--config", o->config,
+      "TOML config (presets: deploy/configs/paper.toml, fast.toml, reach_stop.toml); default: built-in paper settings");
+  cmd->add_option("--set", o->sets, "override one config key, e.g. --set ddpg.gamma=0.95 (repeatable)");
+  cmd->add_option("--seed", o->seed, "random seed (overrides the config's seed)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--run-dir", o->run_dir, "where config, metrics and checkpoints go (default runs/<time>-seed<S>)");
+  cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
+  cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->add_flag("--json", o->json, "print one JSON summary object as the last line");
+  cmd->callback([o] { run_train(*o); });
+}
+
+}  // namespace pamdp::app

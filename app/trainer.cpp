@@ -1,0 +1,362 @@
+#include "app/trainer.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <vector>
+
+#include "actor/exploration.hpp"
+#include "app/actor_policy.hpp"
+#include "app/env_factory.hpp"
+#include "core/files.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/ddpg.hpp"
+#include "replay/replay_buffer.hpp"
+#include "replay/replay_snapshot.hpp"
+
+namespace pamdp::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+uint64_t mix(uint64_t a, uint64_t b) {
+  Rng r(a ^ (b * 0x9E3779B97F4A7C15ULL));
+  return r.next_u64();
+}
+
+// Transitions of the running episode, kept until it ends so that Monte-Carlo returns can be
+// computed before insertion. Sized once for the env's longest episode.
+class EpisodeBuffer {
+ public:
+  EpisodeBuffer(int max_steps, int obs, int act)
+      : obs_(obs),
+        act_(act),
+        states_(size(max_steps, obs)),
+        next_(size(max_steps, obs)),
+        actions_(size(max_steps, act)),
+        rewards_(static_cast<size_t>(max_steps)),
+        returns_(static_cast<size_t>(max_steps)) {}
+  void clear() { n_ = 0; }
+  void push(std::span<const float> s, std::span<const float> a, float r, std::span<const float> s2) {
+    std::copy(s.begin(), s.end(), states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy(a.begin(), a.end(), actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
+    std::copy(s2.begin(), s2.end(), next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    rewards_[n_] = r;
+    ++n_;
+  }
+  // Inserts every transition with its discounted return; the last one is terminal if the
+  // episode ended (always, here: time-outs count as terminals as in the paper's code).
+  void flush(ReplayBuffer& replay, double gamma) {
+    double g = 0.0;
+    for (size_t i = n_; i-- > 0;) {
+      g = rewards_[i] + gamma * g;
+      returns_[i] = static_cast<float>(g);
+    }
+    for (size_t i = 0; i < n_; ++i) {
+      replay.insert({{states_.data() + i * obs_, obs_},
+                     {actions_.data() + i * act_, act_},
+                     rewards_[i],
+                     {next_.data() + i * obs_, obs_},
+                     i + 1 == n_,
+                     returns_[i]});
+    }
+    n_ = 0;
+  }
+  [[nodiscard]] size_t capacity() const { return rewards_.size(); }
+  [[nodiscard]] size_t size() const { return n_; }
+
+ private:
+  static size_t size(int steps, int width) { return static_cast<size_t>(steps) * static_cast<size_t>(width); }
+  size_t obs_, act_;
+  size_t n_ = 0;
+  std::vector<float> states_, next_, actions_, rewards_, returns_;
+};
+
+struct EpisodeStat {
+  float ret;
+  int steps;
+  bool success;
+};
+
+class Trainer {
+ public:
+  Trainer(const ExperimentConfig& c, TrainOptions o)
+      : c_(c),
+        o_(std::move(o)),
+        env_(make_env(c.env)),
+        eval_env_(make_env(c.env)),
+        space_(env_->action_space()),
+        exploration_(resolve_exploration(c, space_)),
+        obs_dim_(env_->observation_size()),
+        width_(space_.output_width()),
+        ddpg_(obs_dim_, space_, c.ddpg, mix(c.seed, 1)),
+        replay_(c.replay.capacity, obs_dim_, width_),
+        explore_(space_, exploration_, mix(c.seed, 2)),
+        sample_rng_(mix(c.seed, 3)),
+        batch_(obs_dim_, width_, c.ddpg.batch_size),
+        episode_(env_->max_episode_steps(), obs_dim_, width_),
+        obs_(static_cast<size_t>(obs_dim_)),
+        next_obs_(static_cast<size_t>(obs_dim_)),
+        net_out_(static_cast<size_t>(width_)),
+        stored_(static_cast<size_t>(width_)) {}
+
+  TrainSummary run();
+
+ private:
+  void resume();
+  void save();
+  void log_tick(bool force);
+  void run_eval();
+  [[nodiscard]] bool should_stop() const;
+  [[nodiscard]] double elapsed() const {
+    return base_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+  ExperimentConfig c_;
+  TrainOptions o_;
+  std::unique_ptr<Env> env_;
+  std::unique_ptr<Env> eval_env_;
+  const ActionSpace& space_;
+  ExplorationConfig exploration_;
+  int obs_dim_;
+  int width_;
+  Ddpg ddpg_;
+  ReplayBuffer replay_;
+  EpsilonGreedy explore_;
+  Rng sample_rng_;
+  BatchBuffers batch_;
+  EpisodeBuffer episode_;
+  std::vector<float> obs_, next_obs_, net_out_, stored_;
+
+  int64_t env_steps_ = 0;
+  int64_t episodes_ = 0;
+  double update_credit_ = 0.0;
+  double base_seconds_ = 0.0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::deque<EpisodeStat> recent_;
+  UpdateStats last_stats_;
+  EvalResult last_eval_;
+  bool have_eval_ = false;
+  int64_t next_eval_ = 0;
+  double last_checkpoint_ = 0.0;
+  double last_log_ = 0.0;
+  int64_t log_updates_ = 0;
+  int64_t log_steps_ = 0;
+  std::ofstream metrics_;
+  std::ofstream episodes_csv_;
+};
+
+void Trainer::resume() {
+  const std::string ck = (fs::path(o_.run_dir) / "checkpoint.ckpt").string();
+  const CheckpointMeta meta = load_checkpoint(ck, ddpg_);
+  if (meta.rng_states.size() != 2) {
+    throw std::runtime_error("checkpoint '" + ck + "' holds " + std::to_string(meta.rng_states.size()) +
+                             " random streams; a train run writes 2");
+  }
+  explore_.rng().set_state(meta.rng_states[0]);
+  sample_rng_.set_state(meta.rng_states[1]);
+  env_steps_ = meta.env_steps;
+  episodes_ = meta.episodes;
+  update_credit_ = meta.update_credit;
+  base_seconds_ = meta.elapsed_seconds;
+  load_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
+}
+
+void Trainer::save() {
+  CheckpointMeta meta;
+  meta.config_toml = to_toml(c_);
+  meta.env_steps = env_steps_;
+  meta.episodes = episodes_;
+  meta.elapsed_seconds = elapsed();
+  meta.update_credit = update_credit_;
+  meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
+  // Replay first: a checkpoint on disk always has a replay snapshot at least as new.
+  save_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
+  save_checkpoint((fs::path(o_.run_dir) / "checkpoint.ckpt").string(), ddpg_, meta);
+  last_checkpoint_ = elapsed();
+}
+
+bool Trainer::should_stop() const {
+  if (o_.stop != nullptr && o_.stop->load()) {
+    return true;
+  }
+  if (ddpg_.updates() >= c_.train.max_updates) {
+    return true;
+  }
+  if (c_.train.max_episodes > 0 && episodes_ >= c_.train.max_episodes) {
+    return true;
+  }
+  return c_.train.max_seconds > 0.0 && elapsed() >= c_.train.max_seconds;
+}
+
+void Trainer::run_eval() {
+  if (c_.train.eval_episodes <= 0) {
+    return;
+  }
+  GreedyActorPolicy policy(ddpg_, space_, exploration_);
+  last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, mix(c_.seed, 1000 + ddpg_.updates()));
+  have_eval_ = true;
+}
+
+void Trainer::log_tick(bool force) {
+  const double now = elapsed();
+  if (!force && now - last_log_ < c_.train.log_every_seconds) {
+    return;
+  }
+  const double dt = std::max(1e-9, now - last_log_);
+  const double ups = static_cast<double>(ddpg_.updates() - log_updates_) / dt;
+  const double sps = static_cast<double>(env_steps_ - log_steps_) / dt;
+  last_log_ = now;
+  log_updates_ = ddpg_.updates();
+  log_steps_ = env_steps_;
+  double ret = 0.0;
+  double steps = 0.0;
+  int goals = 0;
+  for (const auto& e : recent_) {
+    ret += e.ret;
+    steps += e.steps;
+    goals += e.success ? 1 : 0;
+  }
+  const double n = std::max<double>(1.0, static_cast<double>(recent_.size()));
+  const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
+                                    exploration_.epsilon_anneal_updates);
+  metrics_ << now << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << episodes_ << ',' << eps << ',' << goals / n
+           << ',' << ret / n << ',' << steps / n << ',' << last_stats_.critic_loss << ',' << last_stats_.q_mean << ','
+           << ups << ',' << sps << ',';
+  if (have_eval_) {
+    metrics_ << last_eval_.goal_rate << ',' << last_eval_.avg_steps_to_goal << ',' << last_eval_.avg_return;
+  } else {
+    metrics_ << ",,";
+  }
+  metrics_ << '\n' << std::flush;
+  if (!o_.quiet) {
+    std::printf(
+        "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | eps %.3f | loss %.4g | Q %.3f "
+        "| "
+        "%.0f updates/s | %.0f steps/s",
+        now, static_cast<long long>(ddpg_.updates()), static_cast<long long>(episodes_), recent_.size(), goals / n,
+        ret / n, eps, static_cast<double>(last_stats_.critic_loss), static_cast<double>(last_stats_.q_mean), ups, sps);
+    if (have_eval_) {
+      std::printf(" | eval %.2f", last_eval_.goal_rate);
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+}
+
+TrainSummary Trainer::run() {
+  fs::create_directories(o_.run_dir);
+  const fs::path dir(o_.run_dir);
+  if (o_.resume) {
+    resume();
+  } else {
+    const std::string text = to_toml(c_);
+    write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
+  }
+  const bool fresh_metrics = !o_.resume || !fs::exists(dir / "metrics.csv");
+  metrics_.open(dir / "metrics.csv", std::ios::app);
+  episodes_csv_.open(dir / "episodes.csv", std::ios::app);
+  if (!metrics_ || !episodes_csv_) {
+    throw std::runtime_error("cannot write metrics into run directory '" + o_.run_dir + "'");
+  }
+  if (fresh_metrics) {
+    metrics_ << "wall_seconds,updates,env_steps,episodes,epsilon,success_rate_100,mean_return_100,mean_steps_100,"
+                "critic_loss,q_mean,updates_per_s,env_steps_per_s,eval_success_rate,eval_avg_steps_to_success,"
+                "eval_avg_return\n";
+    episodes_csv_ << "episode,wall_seconds,updates,env_steps,return,steps,status\n";
+  }
+  start_ = std::chrono::steady_clock::now();
+  last_log_ = last_checkpoint_ = base_seconds_;
+  log_updates_ = ddpg_.updates();
+  log_steps_ = env_steps_;
+  const int64_t every = c_.train.eval_every_updates;
+  next_eval_ = every > 0 ? (ddpg_.updates() / every + 1) * every : INT64_MAX;
+  const int num_actions = space_.num_actions();
+
+  while (!should_stop()) {
+    // One episode.
+    env_->reset(mix(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
+    episode_.clear();
+    float ep_return = 0.0F;
+    int steps = 0;
+    StepResult sr;
+    do {
+      const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
+                                        exploration_.epsilon_anneal_updates);
+      ddpg_.act(obs_, net_out_);
+      const int id = explore_.select(net_out_, eps, stored_);
+      sr = env_->step({id, std::span<const float>(stored_).subspan(static_cast<size_t>(num_actions))}, next_obs_);
+      episode_.push(obs_, stored_, sr.reward, next_obs_);
+      ep_return += sr.reward;
+      ++steps;
+      ++env_steps_;
+      std::swap(obs_, next_obs_);
+
+      update_credit_ += c_.train.updates_per_step;
+      // Limits are checked at episode ends only (see should_stop), so a run stopped at N updates
+      // and resumed passes through exactly the states of a run that never stopped.
+      while (update_credit_ >= 1.0 && replay_.size() >= c_.replay.warmup) {
+        replay_.sample(sample_rng_, c_.ddpg.batch_size, batch_);
+        const int B = c_.ddpg.batch_size;
+        const BatchView view{
+            Eigen::Map<const Eigen::MatrixXf>(batch_.states.data(), obs_dim_, B),
+            Eigen::Map<const Eigen::MatrixXf>(batch_.actions.data(), width_, B),
+            Eigen::Map<const Eigen::VectorXf>(batch_.rewards.data(), B),
+            Eigen::Map<const Eigen::MatrixXf>(batch_.next_states.data(), obs_dim_, B),
+            Eigen::Map<const Eigen::VectorXf>(batch_.terminal.data(), B),
+            Eigen::Map<const Eigen::VectorXf>(batch_.mc_returns.data(), B),
+        };
+        last_stats_ = ddpg_.update(view);
+        update_credit_ -= 1.0;
+      }
+      if (replay_.size() < c_.replay.warmup) {
+        update_credit_ = std::min(update_credit_, 1.0);  // no debt piles up during warm-up
+      }
+      log_tick(false);
+    } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
+
+    episode_.flush(replay_, c_.ddpg.gamma);
+    ++episodes_;
+    const bool success = sr.status == env_->success_status();
+    recent_.push_back({ep_return, steps, success});
+    if (recent_.size() > 100) {
+      recent_.pop_front();
+    }
+    episodes_csv_ << episodes_ << ',' << elapsed() << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << ep_return
+                  << ',' << steps << ',' << env_->status_name(sr.status) << '\n';
+    if (ddpg_.updates() >= next_eval_) {
+      run_eval();
+      next_eval_ += c_.train.eval_every_updates;
+      log_tick(true);
+    }
+    if (c_.train.checkpoint_every_seconds > 0.0 && elapsed() - last_checkpoint_ >= c_.train.checkpoint_every_seconds) {
+      save();
+    }
+  }
+  save();
+  episodes_csv_.flush();
+  TrainSummary s;
+  run_eval();
+  if (have_eval_) {
+    s.final_eval = last_eval_;
+  }
+  log_tick(true);
+  s.updates = ddpg_.updates();
+  s.env_steps = env_steps_;
+  s.episodes = episodes_;
+  s.seconds = elapsed();
+  return s;
+}
+
+}  // namespace
+
+TrainSummary train(const ExperimentConfig& config, const TrainOptions& options) {
+  Trainer t(config, options);
+  return t.run();
+}
+
+}  // namespace pamdp::app

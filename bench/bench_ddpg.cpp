@@ -1,0 +1,91 @@
+// BM_DdpgUpdate/32: one full DDPG update of the paper's networks (58 -> 1024 -> 512 -> 256 ->
+// 128 -> 4+6 actor, 68 -> ... -> 1 critic) at batch 32 with inverting gradients, through the
+// learner's own Ddpg class; items = updates.
+// BM_GemmRoofline: Eigen float GEMM on this core, the roofline the update is measured against
+// (items = FLOP, so items_per_second reads as FLOP/s).
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "learner/ddpg.hpp"
+
+namespace {
+
+void BM_DdpgUpdate(benchmark::State& state) {
+  const int batch = static_cast<int>(state.range(0));
+  pamdp::DdpgConfig cfg;
+  cfg.batch_size = batch;
+  cfg.bound = pamdp::BoundMethod::kInverting;
+  const pamdp::ActionSpace& space = pamdp::hfo::hfo_action_space();
+  pamdp::Ddpg ddpg(58, space, cfg, 1);
+  pamdp::Rng rng(2);
+  auto random = [&](int rows, int cols, float lo, float hi) {
+    Eigen::MatrixXf m(rows, cols);
+    for (Eigen::Index i = 0; i < m.size(); ++i) {
+      m.data()[i] = static_cast<float>(rng.uniform(lo, hi));
+    }
+    return m;
+  };
+  const Eigen::MatrixXf states = random(58, batch, -1, 1);
+  const Eigen::MatrixXf next_states = random(58, batch, -1, 1);
+  Eigen::MatrixXf actions = random(10, batch, -1, 1);
+  actions.bottomRows(6) *= 100.0F;
+  const Eigen::VectorXf rewards = random(batch, 1, -0.1F, 0.1F);
+  const Eigen::VectorXf terminal = Eigen::VectorXf::Zero(batch);
+  const Eigen::VectorXf returns = Eigen::VectorXf::Zero(batch);
+  const pamdp::BatchView view{
+      Eigen::Map<const Eigen::MatrixXf>(states.data(), 58, batch),
+      Eigen::Map<const Eigen::MatrixXf>(actions.data(), 10, batch),
+      Eigen::Map<const Eigen::VectorXf>(rewards.data(), batch),
+      Eigen::Map<const Eigen::MatrixXf>(next_states.data(), 58, batch),
+      Eigen::Map<const Eigen::VectorXf>(terminal.data(), batch),
+      Eigen::Map<const Eigen::VectorXf>(returns.data(), batch),
+  };
+  for (auto _ : state) {
+    const pamdp::UpdateStats s = ddpg.update(view);
+    benchmark::DoNotOptimize(s.critic_loss);
+  }
+  state.SetItemsProcessed(state.iterations());
+  // FLOP of one update: forward 2*MACs per sample; target actor, target critic, critic,
+  // actor and critic again forward; critic backward (params + input) ~2x forward, critic
+  // backward to inputs only ~1x, actor backward (params) ~1x (no input gradient).
+  auto macs = [](const std::vector<int>& w) {
+    double m = 0;
+    for (size_t i = 0; i + 1 < w.size(); ++i) {
+      m += static_cast<double>(w[i]) * w[i + 1];
+    }
+    return m;
+  };
+  const double a = 2.0 * macs(ddpg.actor().widths()) * batch;
+  const double c = 2.0 * macs(ddpg.critic().widths()) * batch;
+  const double flop = (2 * a + 3 * c) + 2 * c + 1 * c + 1 * a;
+  state.counters["GFLOP_per_update"] = flop / 1e9;
+  state.counters["GFLOP/s"] =
+      benchmark::Counter(flop * static_cast<double>(state.iterations()) / 1e9, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DdpgUpdate)->Arg(32)->Unit(benchmark::kMillisecond);
+
+// C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate of Eigen here.
+void BM_GemmRoofline(benchmark::State& state) {
+  const auto m = state.range(0);
+  const auto k = state.range(1);
+  const auto n = state.range(2);
+  const Eigen::MatrixXf A = Eigen::MatrixXf::Random(m, k);
+  const Eigen::MatrixXf B = Eigen::MatrixXf::Random(k, n);
+  Eigen::MatrixXf C(m, n);
+  for (auto _ : state) {
+    C.noalias() = A * B;
+    benchmark::DoNotOptimize(C.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 2 * m * k * n);
+}
+BENCHMARK(BM_GemmRoofline)
+    ->Args({2048, 2048, 2048})
+    ->Args({512, 1024, 32})
+    ->Args({1024, 512, 32})
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,145 @@
+#include "learner/checkpoint.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include "core/files.hpp"
+#include "schemas/checkpoint_generated.h"
+
+namespace pamdp {
+namespace {
+
+std::vector<uint8_t> read_all(const std::string& path) {
+  return read_file_bytes(path);
+}
+
+const wire::Checkpoint* verified(const std::vector<uint8_t>& bytes, const std::string& path) {
+  if (bytes.size() < 8 || !wire::CheckpointBufferHasIdentifier(bytes.data())) {
+    throw std::runtime_error(
+        "'" + path + "' is not a pamdp checkpoint (wrong file identifier); pass a .ckpt file written by pamdp train");
+  }
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size(), 64, 1000000, false);
+  if (!wire::VerifyCheckpointBuffer(verifier)) {
+    throw std::runtime_error("checkpoint '" + path +
+                             "' is corrupt or truncated (FlatBuffers verification failed); use an earlier checkpoint");
+  }
+  const auto* ck = wire::GetCheckpoint(bytes.data());
+  if (ck->schema_version() != 1) {
+    throw std::runtime_error("checkpoint '" + path + "' has schema version " + std::to_string(ck->schema_version()) +
+                             "; this build reads version 1");
+  }
+  return ck;
+}
+
+void copy_into(const flatbuffers::Vector<float>* src, std::span<float> dst, const char* what, const std::string& path) {
+  if (src == nullptr || src->size() != dst.size()) {
+    throw std::runtime_error("checkpoint '" + path + "': " + what + " has " + std::to_string(src ? src->size() : 0) +
+                             " values, this learner needs " + std::to_string(dst.size()) +
+                             " (was it written with different network widths or env?)");
+  }
+  std::memcpy(dst.data(), src->data(), dst.size() * sizeof(float));
+}
+
+flatbuffers::Offset<wire::AdamState> adam_state(flatbuffers::FlatBufferBuilder& fbb, Adam<float>& adam) {
+  const auto m = fbb.CreateVector(adam.first_moment().data(), adam.first_moment().size());
+  const auto v = fbb.CreateVector(adam.second_moment().data(), adam.second_moment().size());
+  return wire::CreateAdamState(fbb, adam.steps(), m, v);
+}
+
+void restore_adam(const wire::AdamState* s, Adam<float>& adam, const char* what, const std::string& path) {
+  if (s == nullptr) {
+    throw std::runtime_error("checkpoint '" + path + "': missing " + what);
+  }
+  copy_into(s->first_moment(), adam.first_moment(), what, path);
+  copy_into(s->second_moment(), adam.second_moment(), what, path);
+  adam.set_steps(s->steps());
+}
+
+}  // namespace
+
+void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& meta) {
+  flatbuffers::FlatBufferBuilder fbb(1 << 20);
+  const auto vec = [&](Mlp<float>& net) { return fbb.CreateVector(net.params().data(), net.params().size()); };
+  const auto config = fbb.CreateString(meta.config_toml);
+  const auto aw = fbb.CreateVector(ddpg.actor().widths());
+  const auto cw = fbb.CreateVector(ddpg.critic().widths());
+  const auto actor = vec(ddpg.actor());
+  const auto critic = vec(ddpg.critic());
+  const auto target_actor = vec(ddpg.target_actor());
+  const auto target_critic = vec(ddpg.target_critic());
+  const auto actor_adam = adam_state(fbb, ddpg.actor_optimizer());
+  const auto critic_adam = adam_state(fbb, ddpg.critic_optimizer());
+  std::vector<uint64_t> rng_words;
+  for (const auto& s : meta.rng_states) {
+    rng_words.insert(rng_words.end(), s.begin(), s.end());
+  }
+  const auto rngs = fbb.CreateVector(rng_words);
+  wire::CheckpointBuilder b(fbb);
+  b.add_schema_version(1);
+  b.add_config_toml(config);
+  b.add_obs_dim(ddpg.obs_dim());
+  b.add_action_dim(ddpg.output_width());
+  b.add_actor_widths(aw);
+  b.add_critic_widths(cw);
+  b.add_actor(actor);
+  b.add_critic(critic);
+  b.add_target_actor(target_actor);
+  b.add_target_critic(target_critic);
+  b.add_actor_adam(actor_adam);
+  b.add_critic_adam(critic_adam);
+  b.add_updates(ddpg.updates());
+  b.add_env_steps(meta.env_steps);
+  b.add_episodes(meta.episodes);
+  b.add_rng_states(rngs);
+  b.add_elapsed_seconds(meta.elapsed_seconds);
+  b.add_update_credit(meta.update_credit);
+  wire::FinishCheckpointBuffer(fbb, b.Finish());
+  write_file_atomically(path, fbb.GetBufferPointer(), fbb.GetSize());
+}
+
+CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {
+  const std::vector<uint8_t> bytes = read_all(path);
+  const wire::Checkpoint* ck = verified(bytes, path);
+  if (ck->obs_dim() != ddpg.obs_dim() || ck->action_dim() != ddpg.output_width()) {
+    throw std::runtime_error("checkpoint '" + path + "' is for observations of " + std::to_string(ck->obs_dim()) +
+                             " and actions of " + std::to_string(ck->action_dim()) + ", this env has " +
+                             std::to_string(ddpg.obs_dim()) + " and " + std::to_string(ddpg.output_width()));
+  }
+  copy_into(ck->actor(), ddpg.actor().params(), "actor", path);
+  copy_into(ck->critic(), ddpg.critic().params(), "critic", path);
+  copy_into(ck->target_actor(), ddpg.target_actor().params(), "target_actor", path);
+  copy_into(ck->target_critic(), ddpg.target_critic().params(), "target_critic", path);
+  restore_adam(ck->actor_adam(), ddpg.actor_optimizer(), "actor Adam state", path);
+  restore_adam(ck->critic_adam(), ddpg.critic_optimizer(), "critic Adam state", path);
+  ddpg.set_updates(ck->updates());
+  CheckpointMeta meta;
+  meta.config_toml = ck->config_toml() != nullptr ? ck->config_toml()->str() : "";
+  meta.env_steps = ck->env_steps();
+  meta.episodes = ck->episodes();
+  meta.elapsed_seconds = ck->elapsed_seconds();
+  meta.update_credit = ck->update_credit();
+  if (const auto* r = ck->rng_states()) {
+    if (r->size() % 4 != 0) {
+      throw std::runtime_error("checkpoint '" + path + "': RNG state is malformed");
+    }
+    for (flatbuffers::uoffset_t i = 0; i < r->size(); i += 4) {
+      meta.rng_states.push_back({r->Get(i), r->Get(i + 1), r->Get(i + 2), r->Get(i + 3)});
+    }
+  }
+  return meta;
+}
+
+std::string read_checkpoint_config(const std::string& path) {
+  const std::vector<uint8_t> bytes = read_all(path);
+  const wire::Checkpoint* ck = verified(bytes, path);
+  if (ck->config_toml() == nullptr) {
+    throw std::runtime_error("checkpoint '" + path + "' holds no config");
+  }
+  return ck->config_toml()->str();
+}
+
+}  // namespace pamdp

@@ -1,0 +1,32 @@
+// Checkpoints of a DDPG learner: actor, critic, both targets, both Adam states, counters, RNG
+// streams and the resolved config, in one FlatBuffers file (schemas/checkpoint.fbs), written
+// atomically (temp file + fsync + rename) so a crash never leaves a torn checkpoint.
+// Loading verifies the buffer and every size before touching the learner; a corrupt,
+// truncated or mismatched file is refused with a message naming the file and the problem.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "learner/ddpg.hpp"
+
+namespace pamdp {
+
+struct CheckpointMeta {
+  std::string config_toml;
+  int64_t env_steps = 0;
+  int64_t episodes = 0;
+  double elapsed_seconds = 0.0;
+  double update_credit = 0.0;  // fractional updates owed (train.updates_per_step < 1)
+  std::vector<std::array<uint64_t, 4>> rng_states;
+};
+
+void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& meta);
+// Restores `ddpg` (which must have been built with the same shapes) and returns the metadata.
+CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg);
+// Reads only the config stored in a checkpoint (to rebuild the learner before loading).
+std::string read_checkpoint_config(const std::string& path);
+
+}  // namespace pamdp

@@ -1,0 +1,108 @@
+// DDPG for parameterized action spaces (paper §4–5, reference §7.4): an actor that outputs
+// one score per discrete action plus every continuous parameter, a critic Q(s, a) over the
+// whole output vector, target networks, and the actor trained through dQ/da with the
+// parameter gradients kept in bounds (inverting, zeroing or squashing).
+//
+// One update: critic step on the (optionally Monte-Carlo-mixed) TD target with target
+// networks, then an actor step through the just-updated critic (critic parameter gradients of
+// that pass discarded), then soft target updates. update() allocates nothing; not thread-safe.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/action_space.hpp"
+#include "core/bounds.hpp"
+#include "core/mlp.hpp"
+#include "core/optim.hpp"
+#include "core/rng.hpp"
+#include "learner/gradient_bounds.hpp"
+
+namespace pamdp {
+
+struct DdpgConfig {
+  std::vector<int> hidden = {1024, 512, 256, 128};  // both networks, as in the paper
+  double actor_learning_rate = 1e-3;
+  double critic_learning_rate = 1e-3;
+  double adam_beta1 = 0.95;
+  double adam_beta2 = 0.999;
+  double adam_epsilon = 1e-8;
+  double gamma = 0.99;
+  double tau = 1e-4;  // paper text (its code used 1e-3)
+  int batch_size = 32;
+  double clip_grad_norm = 10.0;  // global L2 norm per network; <= 0 disables
+  BoundMethod bound = BoundMethod::kInverting;
+  double mc_mix = 0.0;  // beta: y = beta * MC return + (1 - beta) * TD target
+  double init_std = 0.01;
+  double critic_output_init_std = 0.05;  // the paper-era code's critic output layer
+  double critic_output_init_bias = 1.0;
+};
+
+// A minibatch, one sample per column. Not owned.
+struct BatchView {
+  Eigen::Map<const Eigen::MatrixXf> states;       // obs x B
+  Eigen::Map<const Eigen::MatrixXf> actions;      // (num_actions + num_params) x B, as stored
+  Eigen::Map<const Eigen::VectorXf> rewards;      // B
+  Eigen::Map<const Eigen::MatrixXf> next_states;  // obs x B
+  Eigen::Map<const Eigen::VectorXf> terminal;     // B, 1 if the episode ended at this transition
+  Eigen::Map<const Eigen::VectorXf> mc_returns;   // B (read only when mc_mix > 0)
+};
+
+struct UpdateStats {
+  float critic_loss = 0.0F;  // (1 / 2B) sum (Q - y)^2
+  float q_mean = 0.0F;
+  float target_mean = 0.0F;
+  float critic_grad_norm = 0.0F;  // before clipping
+  float actor_grad_norm = 0.0F;
+};
+
+class Ddpg {
+ public:
+  Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed);
+
+  // The actor's output for one observation, as actors execute and store it (after the squash
+  // when the method is squashing). Writes output_width() values.
+  void act(std::span<const float> obs, std::span<float> out);
+  [[nodiscard]] int output_width() const { return bounds_.width(); }
+  [[nodiscard]] int obs_dim() const { return obs_dim_; }
+
+  UpdateStats update(const BatchView& batch);
+  [[nodiscard]] int64_t updates() const { return updates_; }
+  void set_updates(int64_t n) { updates_ = n; }
+
+  [[nodiscard]] const DdpgConfig& config() const { return config_; }
+  [[nodiscard]] const OutputBounds& bounds() const { return bounds_; }
+
+  Mlp<float>& actor() { return actor_; }
+  Mlp<float>& critic() { return critic_; }
+  Mlp<float>& target_actor() { return target_actor_; }
+  Mlp<float>& target_critic() { return target_critic_; }
+  Adam<float>& actor_optimizer() { return actor_adam_; }
+  Adam<float>& critic_optimizer() { return critic_adam_; }
+
+ private:
+  void actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int batch, Eigen::MatrixXf& out);
+
+  int obs_dim_;
+  DdpgConfig config_;
+  OutputBounds bounds_;
+  Mlp<float> actor_;
+  Mlp<float> critic_;
+  Mlp<float> target_actor_;
+  Mlp<float> target_critic_;
+  Adam<float> actor_adam_;
+  Adam<float> critic_adam_;
+  int64_t updates_ = 0;
+
+  // Scratch, sized for batch_size in the constructor.
+  Eigen::MatrixXf critic_in_;  // (obs + width) x B
+  Eigen::MatrixXf actions_;    // width x B (executed/squashed outputs)
+  Eigen::MatrixXf targets_;    // 1 x B
+  Eigen::MatrixXf d_q_;        // 1 x B
+  Eigen::MatrixXf d_action_;   // width x B
+  Eigen::MatrixXf single_in_;  // obs x 1
+};
+
+}  // namespace pamdp

@@ -1,0 +1,379 @@
+// Learning code: gradient bounds computed by hand, exploration, DDPG target updates, config
+// parsing, checkpoints (atomic, verified, bit-for-bit resume) and an end-to-end test that
+// `pamdp train` solves the toy ReachStop PAMDP.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "actor/exploration.hpp"
+#include "app/experiment_config.hpp"
+#include "app/trainer.hpp"
+#include "core/files.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/toy/reach_stop.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/ddpg.hpp"
+#include "learner/gradient_bounds.hpp"
+#include "replay/replay_buffer.hpp"
+#include "replay/replay_snapshot.hpp"
+
+namespace pamdp {
+namespace {
+
+namespace fs = std::filesystem;
+
+OutputBounds one_bound(float lo, float hi) {
+  OutputBounds b;
+  b.lo = {lo};
+  b.hi = {hi};
+  return b;
+}
+
+float bounded(BoundMethod m, float lo, float hi, float p, float grad, float raw = 0.0F) {
+  Eigen::MatrixXf P(1, 1);
+  Eigen::MatrixXf R(1, 1);
+  Eigen::MatrixXf G(1, 1);
+  P(0, 0) = p;
+  R(0, 0) = raw;
+  G(0, 0) = grad;
+  apply_gradient_bounds(m, one_bound(lo, hi), P, R, G);
+  return G(0, 0);
+}
+
+// Paper §5 / reference §7.4 step 5, with dash power bounds [0, 100]. g < 0 means "increase".
+TEST(GradientBounds, InvertingByHand) {
+  // p = 25, g = -2 (increase): scale (100 - 25) / 100 = 0.75 -> -1.5.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, 0, 100, 25, -2), -1.5F);
+  // p = 25, g = +2 (decrease): scale (25 - 0) / 100 = 0.25 -> 0.5.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, 0, 100, 25, 2), 0.5F);
+  // At the upper bound an "increase" gradient vanishes: (100 - 100) / 100 = 0.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, 0, 100, 100, -2), 0.0F);
+  // Above the bound it is inverted: p = 120, g = -2: (100 - 120) / 100 = -0.2 -> +0.4 (decrease).
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, 0, 100, 120, -2), 0.4F);
+  // Below the lower bound a "decrease" gradient is inverted: p = -10, g = 1: (-10 - 0) / 100 -> -0.1.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, 0, 100, -10, 1), -0.1F);
+  // Directions [-180, 180]: p = 90, g = -1: (180 - 90) / 360 = 0.25.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kInverting, -180, 180, 90, -1), -0.25F);
+}
+
+TEST(GradientBounds, ZeroingByHand) {
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, 50, -3), -3.0F);  // inside: untouched
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, 100, -3), 0.0F);  // at max, pushing up
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, 130, -3), 0.0F);  // above max, pushing up
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, 130, 3), 3.0F);   // above max, pulling back
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, -5, 3), 0.0F);    // below min, pushing down
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kZeroing, 0, 100, -5, -3), -3.0F);  // below min, pulling back
+}
+
+TEST(GradientBounds, SquashingChainRule) {
+  // p = lo + (hi - lo)(tanh(u) + 1)/2; dp/du = (hi - lo)/2 (1 - tanh(u)^2).
+  // u = 0: dp/du = 50 -> g 0.1 becomes 5. u = 1: 50 (1 - tanh(1)^2) = 50 * 0.41997434 = 20.998717.
+  EXPECT_FLOAT_EQ(bounded(BoundMethod::kSquashing, 0, 100, 50, 0.1F, 0.0F), 5.0F);
+  EXPECT_NEAR(bounded(BoundMethod::kSquashing, 0, 100, 88.0797F, 1.0F, 1.0F), 20.998717, 1e-4);
+  // Saturated: u = 10 -> 1 - tanh(10)^2 ~ 8.2e-9, the gradient all but vanishes.
+  EXPECT_LT(std::fabs(bounded(BoundMethod::kSquashing, 0, 100, 100, 1.0F, 10.0F)), 1e-5);
+  std::vector<float> out(1);
+  squash(std::vector<float>{0.0F}, one_bound(-180, 180), out);
+  EXPECT_FLOAT_EQ(out[0], 0.0F);
+}
+
+TEST(GradientBounds, ParsesNames) {
+  BoundMethod m{};
+  EXPECT_TRUE(parse_bound_method("zeroing", &m));
+  EXPECT_EQ(m, BoundMethod::kZeroing);
+  EXPECT_FALSE(parse_bound_method("clip", &m));
+}
+
+TEST(Exploration, EpsilonSchedules) {
+  EXPECT_DOUBLE_EQ(linear_epsilon(0, 1.0, 0.1, 10000), 1.0);
+  EXPECT_DOUBLE_EQ(linear_epsilon(5000, 1.0, 0.1, 10000), 0.55);
+  EXPECT_DOUBLE_EQ(linear_epsilon(10000, 1.0, 0.1, 10000), 0.1);
+  EXPECT_DOUBLE_EQ(linear_epsilon(50000, 1.0, 0.1, 10000), 0.1);
+  // Ape-X: 0.4^(1 + 7 i / (N - 1)); i = 0 -> 0.4, i = N - 1 -> 0.4^8 = 0.00065536.
+  EXPECT_DOUBLE_EQ(apex_epsilon(0, 8), 0.4);
+  EXPECT_NEAR(apex_epsilon(7, 8), 0.00065536, 1e-12);
+  EXPECT_DOUBLE_EQ(apex_epsilon(0, 1), 0.4);
+}
+
+TEST(Exploration, RandomActionsFollowThePaper) {
+  const ActionSpace& space = hfo::hfo_action_space();
+  ExplorationConfig cfg;
+  cfg.masked_actions = {hfo::kTackle};
+  cfg.random_param_lo = {-100, -180, -180, -180, 0, -180};
+  cfg.random_param_hi = {100, 180, 180, 180, 100, 180};
+  EpsilonGreedy eg(space, cfg, 3);
+  std::vector<float> net(10, 0.0F);
+  net[hfo::kTackle] = 5.0F;  // the network prefers tackle; it is masked
+  net[hfo::kKick] = 1.0F;
+  std::vector<float> stored(10);
+  std::vector<int> counts(4, 0);
+  bool saw_back_dash = false;
+  for (int i = 0; i < 6000; ++i) {
+    const int id = eg.select(net, 1.0, stored);
+    ++counts[static_cast<size_t>(id)];
+    for (int a = 0; a < 4; ++a) {
+      EXPECT_GE(stored[static_cast<size_t>(a)], -1.0F);
+      EXPECT_LE(stored[static_cast<size_t>(a)], 1.0F);
+    }
+    EXPECT_GE(stored[4 + hfo::param::kKickPower], 0.0F);
+    saw_back_dash = saw_back_dash || stored[4 + hfo::param::kDashPower] < 0.0F;
+  }
+  EXPECT_EQ(counts[hfo::kTackle], 0);
+  for (int a : {hfo::kDash, hfo::kTurn, hfo::kKick}) {
+    EXPECT_NEAR(counts[static_cast<size_t>(a)] / 6000.0, 1.0 / 3.0, 0.03);  // uniform over 3, ~5 sigma
+  }
+  EXPECT_TRUE(saw_back_dash);
+  // Greedy: tackle masked, so kick wins, and the stored vector is the network's.
+  EXPECT_EQ(eg.select(net, 0.0, stored), hfo::kKick);
+  EXPECT_EQ(stored, net);
+}
+
+TEST(ReplayBuffer, FifoAndSampling) {
+  ReplayBuffer rb(3, 1, 1);
+  Rng rng(1);
+  for (int i = 0; i < 5; ++i) {
+    const float s = static_cast<float>(i);
+    rb.insert({{&s, 1}, {&s, 1}, s, {&s, 1}, i == 4, s});
+  }
+  EXPECT_EQ(rb.size(), 3);
+  EXPECT_EQ(rb.inserted(), 5);
+  BatchBuffers out(1, 1, 64);
+  rb.sample(rng, 64, out);
+  std::set<float> seen(out.rewards.begin(), out.rewards.end());
+  EXPECT_EQ(seen, (std::set<float>{2.0F, 3.0F, 4.0F}));  // 0 and 1 were evicted
+  for (size_t j = 0; j < 64; ++j) {
+    EXPECT_EQ(out.terminal[j], out.rewards[j] == 4.0F ? 1.0F : 0.0F);
+  }
+}
+
+TEST(ReplayBuffer, SnapshotRoundTripAndCorruption) {
+  const fs::path dir = fs::temp_directory_path() / "pamdp_replay_snapshot_test";
+  fs::create_directories(dir);
+  const std::string path = (dir / "replay.bin").string();
+  ReplayBuffer rb(10, 2, 3);
+  const std::vector<float> s{1, 2};
+  const std::vector<float> a{3, 4, 5};
+  for (int i = 0; i < 4; ++i) {
+    rb.insert({s, a, static_cast<float>(i), s, false, 0.5F});
+  }
+  save_replay_snapshot(path, rb);
+  ReplayBuffer back(10, 2, 3);
+  load_replay_snapshot(path, back);
+  EXPECT_EQ(back.size(), 4);
+  EXPECT_EQ(back.inserted(), 4);
+  EXPECT_TRUE(std::equal(rb.raw().begin(), rb.raw().end(), back.raw().begin()));
+  ReplayBuffer other(11, 2, 3);
+  EXPECT_THROW(load_replay_snapshot(path, other), std::runtime_error);
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(60);
+    f.put('\x7f');
+  }
+  try {
+    load_replay_snapshot(path, back);
+    FAIL() << "corrupt snapshot accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("corrupt"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+DdpgConfig tiny_config() {
+  DdpgConfig c;
+  c.hidden = {8};
+  c.batch_size = 4;
+  c.tau = 0.25;
+  return c;
+}
+
+BatchView view_of(const BatchBuffers& b, int obs, int act, int B) {
+  return {Eigen::Map<const Eigen::MatrixXf>(b.states.data(), obs, B),
+          Eigen::Map<const Eigen::MatrixXf>(b.actions.data(), act, B),
+          Eigen::Map<const Eigen::VectorXf>(b.rewards.data(), B),
+          Eigen::Map<const Eigen::MatrixXf>(b.next_states.data(), obs, B),
+          Eigen::Map<const Eigen::VectorXf>(b.terminal.data(), B),
+          Eigen::Map<const Eigen::VectorXf>(b.mc_returns.data(), B)};
+}
+
+TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
+  toy::ReachStopEnv env;
+  Ddpg d(3, env.action_space(), tiny_config(), 5);
+  const std::vector<float> actor_before(d.actor().params().begin(), d.actor().params().end());
+  ASSERT_TRUE(std::equal(actor_before.begin(), actor_before.end(), d.target_actor().params().begin()));
+  BatchBuffers b(3, 3, 4);
+  Rng rng(2);
+  for (auto* v : {&b.states, &b.actions, &b.next_states}) {
+    for (float& x : *v) {
+      x = static_cast<float>(rng.uniform(-1, 1));
+    }
+  }
+  b.rewards = {1, 0, -1, 0.5F};
+  b.terminal = {0, 1, 0, 0};
+  d.update(view_of(b, 3, 3, 4));
+  // theta' = tau theta_new + (1 - tau) theta_old, with theta_old the initial copy.
+  for (size_t i = 0; i < actor_before.size(); ++i) {
+    const float expect = 0.25F * d.actor().params()[i] + 0.75F * actor_before[i];
+    ASSERT_NEAR(d.target_actor().params()[i], expect, 1e-6F) << i;
+  }
+  EXPECT_EQ(d.updates(), 1);
+}
+
+TEST(Ddpg, CriticLearnsAFixedTarget) {
+  // Terminal transitions with reward r: the critic must regress Q(s, a) onto r.
+  toy::ReachStopEnv env;
+  DdpgConfig c = tiny_config();
+  c.hidden = {32, 32};
+  c.actor_learning_rate = 0.0;
+  c.init_std = 0.1;
+  Ddpg d(3, env.action_space(), c, 7);
+  BatchBuffers b(3, 3, 4);
+  Rng rng(3);
+  for (auto* v : {&b.states, &b.actions, &b.next_states}) {
+    for (float& x : *v) {
+      x = static_cast<float>(rng.uniform(-1, 1));
+    }
+  }
+  b.rewards = {1.0F, -0.5F, 0.25F, 0.75F};
+  b.terminal = {1, 1, 1, 1};
+  const float first = d.update(view_of(b, 3, 3, 4)).critic_loss;
+  float last = first;
+  for (int i = 0; i < 400; ++i) {
+    last = d.update(view_of(b, 3, 3, 4)).critic_loss;
+  }
+  EXPECT_GT(first, 0.05F);
+  EXPECT_LT(last, 1e-3F);
+}
+
+app::ExperimentConfig toy_config(int64_t max_updates) {
+  std::ifstream in(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/reach_stop.toml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  app::ExperimentConfig c = app::parse_experiment_config(ss.str(), "reach_stop.toml", {});
+  c.train.max_updates = max_updates;
+  c.train.log_every_seconds = 1e9;
+  return c;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("pamdp_learner_test_" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+TEST(Train, SolvesReachStop) {
+  const fs::path dir = fresh_dir("solve");
+  const app::TrainSummary s = app::train(toy_config(12000), {dir.string(), false, true, nullptr});
+  EXPECT_GE(s.final_eval.goal_rate, 0.9) << "DDPG with inverting gradients failed to learn ReachStop";
+  EXPECT_TRUE(fs::exists(dir / "config.toml"));
+  EXPECT_TRUE(fs::exists(dir / "metrics.csv"));
+  EXPECT_TRUE(fs::exists(dir / "episodes.csv"));
+  fs::remove_all(dir);
+}
+
+std::vector<float> params_of(const std::string& ckpt, const app::ExperimentConfig& c) {
+  toy::ReachStopEnv env;
+  Ddpg d(3, env.action_space(), c.ddpg, 99);
+  load_checkpoint(ckpt, d);
+  std::vector<float> all(d.actor().params().begin(), d.actor().params().end());
+  all.insert(all.end(), d.critic().params().begin(), d.critic().params().end());
+  all.insert(all.end(), d.target_critic().params().begin(), d.target_critic().params().end());
+  all.insert(all.end(), d.critic_optimizer().second_moment().begin(), d.critic_optimizer().second_moment().end());
+  return all;
+}
+
+TEST(Train, ResumeIsBitForBit) {
+  const fs::path a = fresh_dir("straight");
+  const fs::path b = fresh_dir("halves");
+  const app::ExperimentConfig full = toy_config(3000);
+  app::train(full, {a.string(), false, true, nullptr});
+  app::train(toy_config(1500), {b.string(), false, true, nullptr});
+  app::train(full, {b.string(), true, true, nullptr});
+  EXPECT_EQ(read_file_bytes((a / "replay.bin").string()), read_file_bytes((b / "replay.bin").string()));
+  EXPECT_EQ(params_of((a / "checkpoint.ckpt").string(), full), params_of((b / "checkpoint.ckpt").string(), full));
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
+  const fs::path dir = fresh_dir("corrupt");
+  fs::create_directories(dir);
+  const std::string path = (dir / "c.ckpt").string();
+  toy::ReachStopEnv env;
+  Ddpg d(3, env.action_space(), tiny_config(), 1);
+  save_checkpoint(path, d, {});
+  EXPECT_NO_THROW(load_checkpoint(path, d));
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+
+  std::vector<uint8_t> bytes = read_file_bytes(path);
+  const std::vector<uint8_t> good = bytes;
+  bytes.resize(bytes.size() / 2);
+  write_file_atomically(path, bytes.data(), bytes.size());
+  EXPECT_THROW(load_checkpoint(path, d), std::runtime_error);
+
+  bytes = good;
+  bytes[4] = 'X';  // file identifier
+  write_file_atomically(path, bytes.data(), bytes.size());
+  EXPECT_THROW(load_checkpoint(path, d), std::runtime_error);
+
+  write_file_atomically(path, good.data(), good.size());
+  DdpgConfig wider = tiny_config();
+  wider.hidden = {9};
+  Ddpg other(3, env.action_space(), wider, 1);
+  try {
+    load_checkpoint(path, other);
+    FAIL() << "mismatched checkpoint accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("widths"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_checkpoint((dir / "missing.ckpt").string(), d), std::runtime_error);
+  fs::remove_all(dir);
+}
+
+TEST(Config, DefaultsRoundTripAndOverrides) {
+  const app::ExperimentConfig def = app::parse_experiment_config("", "empty", {});
+  EXPECT_EQ(def.ddpg.hidden, (std::vector<int>{1024, 512, 256, 128}));
+  const app::ExperimentConfig back = app::parse_experiment_config(app::to_toml(def), "round-trip", {});
+  EXPECT_EQ(app::to_toml(back), app::to_toml(def));
+  const app::ExperimentConfig o =
+      app::parse_experiment_config("", "x", {"ddpg.gamma=0.5", "ddpg.bound=squashing", "env.noise=false", "seed=9"});
+  EXPECT_DOUBLE_EQ(o.ddpg.gamma, 0.5);
+  EXPECT_EQ(o.ddpg.bound, BoundMethod::kSquashing);
+  EXPECT_FALSE(o.env.hfo.noise);
+  EXPECT_EQ(o.seed, 9U);
+}
+
+TEST(Config, PaperPresetIsTheDefault) {
+  const app::ExperimentConfig paper =
+      app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/paper.toml", {});
+  EXPECT_EQ(app::to_toml(paper), app::to_toml(app::ExperimentConfig{}));
+  EXPECT_NO_THROW(app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/fast.toml", {}));
+}
+
+void expect_error(const std::string& text, const std::vector<std::string>& sets, const std::string& needle) {
+  try {
+    app::parse_experiment_config(text, "cfg.toml", sets);
+    FAIL() << "accepted: " << text;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(Config, ErrorsNameTheKeyAndTheChoices) {
+  expect_error("[ddpg]\ngama = 0.9\n", {}, "unknown key 'ddpg.gama'");
+  expect_error("[ddpg]\ngama = 0.9\n", {}, "gamma");  // lists the valid keys
+  expect_error("[dpg]\n", {}, "valid: ");
+  expect_error("[ddpg]\ngamma = 1.5\n", {}, "'ddpg.gamma' must be within [0, 1]");
+  expect_error("[ddpg]\nbound = 'clip'\n", {}, "inverting, zeroing, squashing");
+  expect_error("[ddpg]\nbatch_size = 'big'\n", {}, "'ddpg.batch_size' must be an integer");
+  expect_error("[ddpg\n", {}, "not valid TOML");
+  expect_error("", {"ddpg.gamma"}, "expected key=value");
+  expect_error("[replay]\nwarmup = 10\n", {}, "replay.warmup must be at least ddpg.batch_size");
+}
+
+}  // namespace
+}  // namespace pamdp
