@@ -12,6 +12,8 @@ namespace {
 int run(int argc, char** argv) {
   CLI::App app{"pamdp: DDPG in parameterized action spaces (Hausknecht & Stone, ICLR 2016) on Half Field Offense"};
   app.require_subcommand(1);
+  // On a parse error also show the usage, so an unknown or missing subcommand lists the valid ones.
+  app.failure_message(CLI::FailureMessage::help);
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
@@ -22,6 +24,16 @@ int run(int argc, char** argv) {
   pamdp::app::register_sim(app);
   pamdp::app::register_train(app);
 
+  std::string valid;
+  bool known = false;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    valid += (valid.empty() ? "" : ", ") + sub->get_name();
+    known = known || (argc > 1 && sub->get_name() == argv[1]);
+  }
+  if (argc > 1 && argv[1][0] != '-' && !known) {
+    std::fprintf(stderr, "pamdp: unknown subcommand '%s' (valid: %s); see pamdp --help\n", argv[1], valid.c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,11 +1,15 @@
 #include "core/policy.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace pamdp {
 
 RandomPolicy::RandomPolicy(const ActionSpace& space, uint64_t seed, std::vector<int> allowed_actions)
     : allowed_(std::move(allowed_actions)), params_(space.params.size()), rng_(seed) {
+  if (space.num_actions() == 0) {
+    throw std::invalid_argument("RandomPolicy: the action space has no actions");
+  }
   if (allowed_.empty()) {
     for (int i = 0; i < space.num_actions(); ++i) {
       allowed_.push_back(i);
@@ -23,6 +27,9 @@ RandomPolicy::RandomPolicy(const ActionSpace& space, uint64_t seed, std::vector<
 }
 
 void RandomPolicy::set_param_range(int index, float lo, float hi) {
+  if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi)) {
+    throw std::invalid_argument("RandomPolicy: parameter range needs finite lo <= hi");
+  }
   lo_.at(static_cast<size_t>(index)) = lo;
   hi_.at(static_cast<size_t>(index)) = hi;
 }

@@ -1,6 +1,8 @@
 #include "learner/evaluation.hpp"
 
 #include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace pamdp {
@@ -27,8 +29,14 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed) {
       sr = env.step(policy.act(obs), obs);
       total_return += sr.reward;
       ++steps;
-    } while (!sr.terminal());
+    } while (!sr.terminal() && steps <= env.max_episode_steps());
+    if (!sr.terminal()) {
+      throw std::runtime_error("evaluate: env '" + std::string(env.name()) + "' ran past its max_episode_steps()");
+    }
     total_steps += steps;
+    if (sr.status < 0) {
+      throw std::runtime_error("evaluate: env '" + std::string(env.name()) + "' returned a negative status");
+    }
     if (static_cast<size_t>(sr.status) >= counts.size()) {
       counts.resize(static_cast<size_t>(sr.status) + 1, 0);
     }

@@ -1,9 +1,19 @@
 #include "envs/hfo/hfo_env.hpp"
 
-#include <cassert>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace pamdp::hfo {
+namespace {
+
+// Programmer misuse (not a user error): stop with a message, also in Release builds.
+[[noreturn]] void misuse(const char* what) {
+  std::fprintf(stderr, "HfoEnv: %s\n", what);
+  std::abort();
+}
+
+}  // namespace
 
 const ActionSpace& hfo_action_space() {
   static const ActionSpace kSpace{
@@ -70,6 +80,7 @@ std::span<const int> HfoEnv::outcomes() const {
 
 void HfoEnv::begin_episode(std::span<float> obs) {
   reward_.reset();
+  episode_over_ = false;
   write_features(sim_.state(), obs);
 }
 
@@ -89,16 +100,22 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, std::spa
 }
 
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
-  assert(action.params.size() >= static_cast<size_t>(param::kCount));
+  if (action.params.size() < static_cast<size_t>(param::kCount)) {
+    misuse("step(): the parameter vector must hold the 6 HFO parameters");
+  }
+  if (episode_over_) {
+    misuse("step() after a terminal status; call reset() first");
+  }
   const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
   switch (action.id) {
     case kDash: sim_.dash(p(param::kDashPower), p(param::kDashDir)); break;
     case kTurn: sim_.turn(p(param::kTurnDir)); break;
     case kTackle: sim_.tackle(p(param::kTackleDir)); break;
     case kKick: sim_.kick(p(param::kKickPower), p(param::kKickDir)); break;
-    default: assert(false && "action id out of range"); break;
+    default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
   }
   const int status = sim_.step();
+  episode_over_ = status != kInGame;
   write_features(sim_.state(), obs);
   return {reward_(obs, status), status};
 }

@@ -76,6 +76,7 @@ class HfoEnv final : public Env {
 
   SoccerSim sim_;
   ShapedReward reward_;
+  bool episode_over_ = false;
 };
 
 }  // namespace pamdp::hfo

@@ -93,10 +93,11 @@ std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
       line.pop_back();
     }
-    if (line.empty() || line[0] == '#') {
+    const auto first_char = line.find_first_not_of(" \t");
+    if (first_char == std::string::npos || line[first_char] == '#') {
       continue;
     }
     std::vector<std::string> cells;
@@ -106,6 +107,9 @@ std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std
       const auto first = cell.find_first_not_of(" \t");
       const auto last = cell.find_last_not_of(" \t");
       cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
+    }
+    if (line.back() == ',') {
+      cells.emplace_back();  // a trailing comma is one more (empty) cell, so the arity check sees it
     }
     const std::string where = src + ":" + std::to_string(line_no) + ": ";
     auto num = [&](size_t i) {
