@@ -71,6 +71,7 @@ void visit(V& v, ExperimentConfig& c) {
 
   v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
+  v.integer("replay.shards", c.replay.shards, 1, 1024);
 
   v.integer("train.max_updates", c.train.max_updates, 0, INT64_MAX);
   v.integer("train.max_episodes", c.train.max_episodes, 0, INT64_MAX);
@@ -80,6 +81,19 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("train.eval_episodes", c.train.eval_episodes, 0, 1000000);
   v.real("train.checkpoint_every_seconds", c.train.checkpoint_every_seconds, 0.0, 1e9);
   v.real("train.log_every_seconds", c.train.log_every_seconds, 0.0, 1e9);
+
+  v.text("cluster.learner_bind", c.cluster.learner_bind);
+  v.text("cluster.weights_bind", c.cluster.weights_bind);
+  v.text("cluster.advertise_host", c.cluster.advertise_host);
+  v.integer("cluster.publish_every_updates", c.cluster.publish_every_updates, 1, INT64_MAX);
+  v.integer("cluster.actor_batch_transitions", c.cluster.actor_batch_transitions, 1, 65536);
+  v.real("cluster.samples_per_insert", c.cluster.samples_per_insert, 0.0, 1e6);
+  v.integer("cluster.rate_limit_slack", c.cluster.rate_limit_slack, 1, INT64_MAX);
+  v.integer("cluster.requests_in_flight_per_shard", c.cluster.requests_in_flight_per_shard, 1, 64);
+  v.integer("cluster.heartbeat_ms", c.cluster.heartbeat_ms, 10, 600000);
+  v.integer("cluster.peer_timeout_ms", c.cluster.peer_timeout_ms, 100, 3600000);
+  v.boolean("cluster.curve", c.cluster.curve);
+  v.text("cluster.curve_keys_dir", c.cluster.curve_keys_dir);
 }
 
 class Reader {
@@ -109,6 +123,15 @@ class Reader {
         std::ostringstream ss;
         ss << "must be within [" << lo << ", " << hi << "], got " << *v;
         fail(key, ss.str());
+      }
+      out = *v;
+    }
+  }
+  void text(const std::string& key, std::string& out) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value_exact<std::string>();
+      if (!v || v->empty()) {
+        fail(key, "must be a non-empty string");
       }
       out = *v;
     }
@@ -272,6 +295,7 @@ class Writer {
   }
   void real(const std::string& key, const double& v, double /*lo*/, double /*hi*/) { put(key, v); }
   void boolean(const std::string& key, const bool& v) { put(key, v); }
+  void text(const std::string& key, const std::string& v) { put(key, v); }
   template <typename E>
   void choice(const std::string& key, const E& v, const Choices<E>& choices) {
     for (const auto& [name, value] : choices) {

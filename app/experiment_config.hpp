@@ -23,6 +23,25 @@ struct EnvConfig {
 struct ReplayConfig {
   int64_t capacity = 500000;
   int64_t warmup = 10000;  // transitions stored before the first update
+  int shards = 2;          // distributed: capacity and warm-up are split evenly across shards
+};
+
+// The distributed system (docs/protocol.md). Endpoints are ZeroMQ addresses.
+struct ClusterConfig {
+  std::string learner_bind = "tcp://*:5555";  // join socket (ROUTER)
+  std::string weights_bind = "tcp://*:5556";  // weights broadcast (PUB)
+  std::string advertise_host = "127.0.0.1";   // how peers reach this machine's bound ports
+  int64_t publish_every_updates = 100;
+  int actor_batch_transitions = 64;  // transitions per TransitionBatch message
+  // Samples per inserted transition the shards allow (0: updates_per_step * batch_size, the
+  // single-process ratio), and how far inserts may run ahead of / behind it, in transitions.
+  double samples_per_insert = 0.0;
+  int64_t rate_limit_slack = 2000;
+  int requests_in_flight_per_shard = 2;
+  int heartbeat_ms = 1000;
+  int peer_timeout_ms = 5000;
+  bool curve = false;                   // CURVE encryption + authentication on every socket
+  std::string curve_keys_dir = "keys";  // written by pamdp keygen
 };
 
 struct TrainLoopConfig {
@@ -48,6 +67,7 @@ struct ExperimentConfig {
       {"dash_power", {-100.0F, 100.0F}}};
   ReplayConfig replay;
   TrainLoopConfig train;
+  ClusterConfig cluster;
 };
 
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws

@@ -1,0 +1,271 @@
+#include "core/transport.hpp"
+
+#include <zmq.h>
+
+#include <stdexcept>
+#include <zmq.hpp>
+
+namespace pamdp::net {
+namespace {
+
+int zmq_type(SocketType t) {
+  switch (t) {
+    case SocketType::kRouter: return ZMQ_ROUTER;
+    case SocketType::kDealer: return ZMQ_DEALER;
+    case SocketType::kPub: return ZMQ_PUB;
+    case SocketType::kSub: return ZMQ_SUB;
+    case SocketType::kPush: return ZMQ_PUSH;
+    case SocketType::kPull: return ZMQ_PULL;
+  }
+  return ZMQ_DEALER;
+}
+
+bool wait_for(void* socket, short events, int timeout_ms) {
+  zmq_pollitem_t item{socket, 0, events, 0};
+  while (true) {
+    const int rc = zmq_poll(&item, 1, timeout_ms);
+    if (rc >= 0) {
+      return rc > 0 && (item.revents & events) != 0;
+    }
+    if (zmq_errno() != EINTR) {
+      return false;
+    }
+  }
+}
+
+}  // namespace
+
+struct Context::Impl {
+  zmq::context_t ctx{1};
+};
+Context::Context() : impl_(std::make_unique<Impl>()) {}
+Context::~Context() = default;
+void* Context::raw() const {
+  return impl_->ctx.handle();
+}
+
+struct Message::Impl {
+  zmq::message_t msg;
+};
+Message::Message() : impl_(std::make_unique<Impl>()) {}
+Message::~Message() = default;
+const uint8_t* Message::data() const {
+  return static_cast<const uint8_t*>(impl_->msg.data());
+}
+size_t Message::size() const {
+  return impl_->msg.size();
+}
+void* Message::raw() {
+  return &impl_->msg;
+}
+
+Socket::Socket(Context& ctx, SocketType type) : sock_(zmq_socket(ctx.raw(), zmq_type(type))) {
+  if (sock_ == nullptr) {
+    throw std::runtime_error(std::string("cannot create socket: ") + zmq_strerror(zmq_errno()));
+  }
+  const int linger = 0;
+  zmq_setsockopt(sock_, ZMQ_LINGER, &linger, sizeof(linger));
+}
+
+Socket::~Socket() {
+  if (sock_ != nullptr) {
+    zmq_close(sock_);
+  }
+}
+
+Socket::Socket(Socket&& o) noexcept : sock_(o.sock_) {
+  o.sock_ = nullptr;
+}
+
+Socket& Socket::operator=(Socket&& o) noexcept {
+  if (this != &o) {
+    if (sock_ != nullptr) {
+      zmq_close(sock_);
+    }
+    sock_ = o.sock_;
+    o.sock_ = nullptr;
+  }
+  return *this;
+}
+
+namespace {
+void setopt(void* s, int opt, const void* value, size_t len, const char* what) {
+  if (zmq_setsockopt(s, opt, value, len) != 0) {
+    throw std::runtime_error(std::string("cannot set ") + what + ": " + zmq_strerror(zmq_errno()));
+  }
+}
+void setint(void* s, int opt, int v, const char* what) {
+  setopt(s, opt, &v, sizeof(v), what);
+}
+}  // namespace
+
+void Socket::set_send_hwm(int messages) {
+  setint(raw(), ZMQ_SNDHWM, messages, "send high water mark");
+}
+void Socket::set_recv_hwm(int messages) {
+  setint(raw(), ZMQ_RCVHWM, messages, "receive high water mark");
+}
+void Socket::set_linger_ms(int ms) {
+  setint(raw(), ZMQ_LINGER, ms, "linger");
+}
+void Socket::set_router_mandatory(bool on) {
+  setint(raw(), ZMQ_ROUTER_MANDATORY, on ? 1 : 0, "router mandatory");
+}
+void Socket::set_max_message_bytes(int64_t bytes) {
+  setopt(raw(), ZMQ_MAXMSGSIZE, &bytes, sizeof(bytes), "max message size");
+}
+void Socket::subscribe_all() {
+  setopt(raw(), ZMQ_SUBSCRIBE, "", 0, "subscription");
+}
+
+void Socket::make_curve_server(const CurveServerKeys& keys) {
+  setint(raw(), ZMQ_CURVE_SERVER, 1, "CURVE server mode");
+  setopt(raw(), ZMQ_CURVE_SECRETKEY, keys.secret_key.c_str(), keys.secret_key.size(), "CURVE secret key");
+}
+
+void Socket::make_curve_client(const CurveClientKeys& keys) {
+  setopt(raw(), ZMQ_CURVE_SERVERKEY, keys.server_public_key.c_str(), keys.server_public_key.size(),
+         "CURVE server public key");
+  setopt(raw(), ZMQ_CURVE_PUBLICKEY, keys.public_key.c_str(), keys.public_key.size(), "CURVE public key");
+  setopt(raw(), ZMQ_CURVE_SECRETKEY, keys.secret_key.c_str(), keys.secret_key.size(), "CURVE secret key");
+}
+
+std::string Socket::bind(const std::string& endpoint) {
+  if (zmq_bind(raw(), endpoint.c_str()) != 0) {
+    const int err = zmq_errno();
+    std::string hint = err == EADDRINUSE ? " (address in use: pick another port or stop the process holding it)"
+                                         : " (expected tcp://HOST:PORT, tcp://*:PORT, ipc://PATH or inproc://NAME)";
+    throw std::runtime_error("cannot bind '" + endpoint + "': " + zmq_strerror(err) + hint);
+  }
+  char buf[512];
+  size_t len = sizeof(buf);
+  if (zmq_getsockopt(raw(), ZMQ_LAST_ENDPOINT, buf, &len) != 0) {
+    return endpoint;
+  }
+  return std::string(buf);
+}
+
+void Socket::connect(const std::string& endpoint) {
+  if (zmq_connect(raw(), endpoint.c_str()) != 0) {
+    throw std::runtime_error("cannot connect to '" + endpoint + "': " + zmq_strerror(zmq_errno()) +
+                             " (expected tcp://HOST:PORT, ipc://PATH or inproc://NAME)");
+  }
+}
+
+void Socket::disconnect(const std::string& endpoint) {
+  zmq_disconnect(raw(), endpoint.c_str());
+}
+
+bool Socket::send(std::span<const uint8_t> payload, int timeout_ms) {
+  if (timeout_ms > 0 && !wait_for(raw(), ZMQ_POLLOUT, timeout_ms)) {
+    return false;
+  }
+  const int flags = timeout_ms < 0 ? 0 : ZMQ_DONTWAIT;
+  while (zmq_send(raw(), payload.data(), payload.size(), flags) < 0) {
+    if (zmq_errno() != EINTR) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool Socket::send_to(std::span<const uint8_t> identity, std::span<const uint8_t> payload, int timeout_ms) {
+  if (timeout_ms > 0 && !wait_for(raw(), ZMQ_POLLOUT, timeout_ms)) {
+    return false;
+  }
+  const int flags = timeout_ms < 0 ? 0 : ZMQ_DONTWAIT;
+  if (zmq_send(raw(), identity.data(), identity.size(), flags | ZMQ_SNDMORE) < 0) {
+    return false;
+  }
+  return zmq_send(raw(), payload.data(), payload.size(), flags) >= 0;
+}
+
+bool Socket::recv(Message& out, int timeout_ms) {
+  if (timeout_ms >= 0 && !wait_for(raw(), ZMQ_POLLIN, timeout_ms)) {
+    return false;
+  }
+  auto* msg = static_cast<zmq::message_t*>(out.raw());
+  while (zmq_msg_recv(msg->handle(), raw(), 0) < 0) {
+    if (zmq_errno() != EINTR) {
+      return false;
+    }
+  }
+  // Drain any extra frames: the protocol sends one frame per message.
+  while (msg->more()) {
+    zmq::message_t extra;
+    zmq_msg_recv(extra.handle(), raw(), 0);
+    if (!extra.more()) {
+      msg->rebuild(static_cast<size_t>(0));
+      break;
+    }
+  }
+  return true;
+}
+
+bool Socket::recv_from(Message& identity, Message& payload, int timeout_ms) {
+  if (timeout_ms >= 0 && !wait_for(raw(), ZMQ_POLLIN, timeout_ms)) {
+    return false;
+  }
+  auto* id = static_cast<zmq::message_t*>(identity.raw());
+  auto* msg = static_cast<zmq::message_t*>(payload.raw());
+  while (zmq_msg_recv(id->handle(), raw(), 0) < 0) {
+    if (zmq_errno() != EINTR) {
+      return false;
+    }
+  }
+  if (!id->more()) {
+    msg->rebuild(static_cast<size_t>(0));
+    return true;
+  }
+  zmq_msg_recv(msg->handle(), raw(), 0);
+  if (msg->more()) {
+    // More than [identity, payload]: not our protocol. Drain and report an empty payload.
+    zmq::message_t extra;
+    do {
+      zmq_msg_recv(extra.handle(), raw(), 0);
+    } while (extra.more());
+    msg->rebuild(static_cast<size_t>(0));
+  }
+  return true;
+}
+
+bool Socket::wait_readable(int timeout_ms) {
+  return wait_for(raw(), ZMQ_POLLIN, timeout_ms);
+}
+
+void Poller::add(Socket& s) {
+  sockets_.push_back(s.raw());
+  revents_.push_back(0);
+}
+
+int Poller::poll(int timeout_ms) {
+  std::vector<zmq_pollitem_t> items;
+  items.reserve(sockets_.size());
+  for (void* s : sockets_) {
+    items.push_back({s, 0, ZMQ_POLLIN, 0});
+  }
+  int rc = 0;
+  do {
+    rc = zmq_poll(items.data(), static_cast<int>(items.size()), timeout_ms);
+  } while (rc < 0 && zmq_errno() == EINTR);
+  for (size_t i = 0; i < items.size(); ++i) {
+    revents_[i] = items[i].revents;
+  }
+  return rc < 0 ? 0 : rc;
+}
+
+bool Poller::readable(size_t index) const {
+  return (revents_[index] & ZMQ_POLLIN) != 0;
+}
+
+CurveServerKeys generate_curve_keypair() {
+  char pub[41];
+  char sec[41];
+  if (zmq_curve_keypair(pub, sec) != 0) {
+    throw std::runtime_error(std::string("cannot generate CURVE keys: ") + zmq_strerror(zmq_errno()) +
+                             " (libzmq built without CURVE support?)");
+  }
+  return {pub, sec};
+}
+
+}  // namespace pamdp::net

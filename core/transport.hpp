@@ -1,0 +1,126 @@
+// The transport seam: the only header that knows ZeroMQ. Roles send and receive opaque byte
+// buffers (FlatBuffers envelopes, see core/wire.hpp) through these sockets, over inproc://,
+// ipc:// or tcp://, optionally with CURVE encryption and authentication.
+//
+// Threading: a Context may be shared by threads; a Socket belongs to one thread at a time.
+// Costs: send/recv copy nothing beyond what ZeroMQ itself does; Message objects are reused by
+// the caller so that steady-state receiving allocates only inside ZeroMQ.
+// Errors: setup failures a user can cause (a bad endpoint, a port in use) throw
+// std::runtime_error naming the endpoint and the fix; timeouts are returned as false.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pamdp::net {
+
+class Context {
+ public:
+  Context();
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+  [[nodiscard]] void* raw() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A received frame. Reuse one per receive site.
+class Message {
+ public:
+  Message();
+  ~Message();
+  Message(const Message&) = delete;
+  Message& operator=(const Message&) = delete;
+  [[nodiscard]] const uint8_t* data() const;
+  [[nodiscard]] size_t size() const;
+  [[nodiscard]] std::span<const uint8_t> bytes() const { return {data(), size()}; }
+  [[nodiscard]] void* raw();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+enum class SocketType { kRouter, kDealer, kPub, kSub, kPush, kPull };
+
+// CURVE keys as 40-character Z85 strings (pamdp keygen writes them).
+struct CurveServerKeys {
+  std::string public_key;
+  std::string secret_key;
+};
+struct CurveClientKeys {
+  std::string public_key;
+  std::string secret_key;
+  std::string server_public_key;
+};
+
+class Socket {
+ public:
+  Socket(Context& ctx, SocketType type);
+  ~Socket();
+  Socket(Socket&&) noexcept;
+  Socket& operator=(Socket&&) noexcept;
+  Socket(const Socket&) = delete;
+  Socket& operator=(const Socket&) = delete;
+
+  // High water marks (messages queued before send blocks / incoming messages are held back).
+  void set_send_hwm(int messages);
+  void set_recv_hwm(int messages);
+  void set_linger_ms(int ms);
+  // ROUTER: report unroutable messages as errors instead of dropping them silently.
+  void set_router_mandatory(bool on);
+  // Largest message accepted; bigger ones make ZeroMQ drop the peer's connection (a cheap first
+  // line of defence against oversized messages). -1 = no limit.
+  void set_max_message_bytes(int64_t bytes);
+  void subscribe_all();  // SUB only
+  void make_curve_server(const CurveServerKeys& keys);
+  void make_curve_client(const CurveClientKeys& keys);
+
+  // Binds and returns the resolved endpoint (tcp://host:* becomes tcp://host:PORT).
+  std::string bind(const std::string& endpoint);
+  void connect(const std::string& endpoint);
+  void disconnect(const std::string& endpoint);
+
+  // Sends one frame. timeout_ms: -1 blocks, 0 never blocks, > 0 waits at most that long.
+  // Returns false if it could not be queued in time (peer gone or queue full).
+  bool send(std::span<const uint8_t> payload, int timeout_ms = -1);
+  // ROUTER: sends [identity, payload].
+  bool send_to(std::span<const uint8_t> identity, std::span<const uint8_t> payload, int timeout_ms = 0);
+  // Receives one frame; false on timeout.
+  bool recv(Message& out, int timeout_ms = -1);
+  // ROUTER: receives [identity, payload]; extra frames are drained and the message is
+  // reported as malformed by returning true with an empty payload.
+  bool recv_from(Message& identity, Message& payload, int timeout_ms = -1);
+
+  // Waits until the socket has something to read; false on timeout.
+  bool wait_readable(int timeout_ms);
+  [[nodiscard]] void* raw() const { return sock_; }
+
+ private:
+  void* sock_ = nullptr;  // the ZeroMQ socket handle
+};
+
+// Waits on several sockets at once; returns the indices of the readable ones.
+class Poller {
+ public:
+  void add(Socket& s);
+  // Returns how many are readable; readable(i) tells which.
+  int poll(int timeout_ms);
+  [[nodiscard]] bool readable(size_t index) const;
+
+ private:
+  std::vector<void*> sockets_;
+  std::vector<short> revents_;
+};
+
+// Generates a CURVE key pair (Z85). Throws if libzmq was built without CURVE.
+CurveServerKeys generate_curve_keypair();
+
+}  // namespace pamdp::net

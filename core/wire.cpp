@@ -1,0 +1,150 @@
+#include "core/wire.hpp"
+
+#include <cmath>
+
+namespace pamdp::wire {
+namespace {
+
+void finish(flatbuffers::FlatBufferBuilder& fbb, Payload type, flatbuffers::Offset<void> payload) {
+  EnvelopeBuilder env(fbb);
+  env.add_schema_version(kSchemaVersion);
+  env.add_payload_type(type);
+  env.add_payload(payload);
+  FinishEnvelopeBuffer(fbb, env.Finish());
+}
+
+bool all_finite(const flatbuffers::Vector<float>* v) {
+  for (flatbuffers::uoffset_t i = 0; i < v->size(); ++i) {
+    if (!std::isfinite(v->Get(i))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+flatbuffers::Offset<TransitionBatch> batch_offset(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id,
+                                                  uint64_t sequence, const TransitionRows& r) {
+  const size_t n = r.count;
+  const auto states = fbb.CreateVector(r.states, n * r.obs_dim);
+  const auto actions = fbb.CreateVector(r.actions, n * r.action_dim);
+  const auto rewards = fbb.CreateVector(r.rewards, n);
+  const auto next_states = fbb.CreateVector(r.next_states, n * r.obs_dim);
+  const auto terminals = fbb.CreateVector(r.terminals, n);
+  const auto returns = fbb.CreateVector(r.mc_returns, n);
+  return CreateTransitionBatch(fbb, actor_id, sequence, r.obs_dim, r.action_dim, r.count, states, actions, rewards,
+                               next_states, terminals, returns);
+}
+
+}  // namespace
+
+const Envelope* open_envelope(std::span<const uint8_t> bytes) {
+  if (bytes.size() < 8 || !EnvelopeBufferHasIdentifier(bytes.data())) {
+    return nullptr;
+  }
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size());
+  if (!VerifyEnvelopeBuffer(verifier)) {
+    return nullptr;
+  }
+  const Envelope* env = GetEnvelope(bytes.data());
+  if (env->schema_version() != kSchemaVersion || env->payload() == nullptr) {
+    return nullptr;
+  }
+  return env;
+}
+
+bool valid_batch(const TransitionBatch* b, uint32_t obs_dim, uint32_t action_dim, uint32_t max_count) {
+  if (b == nullptr || b->obs_dim() != obs_dim || b->action_dim() != action_dim || b->count() == 0 ||
+      b->count() > max_count) {
+    return false;
+  }
+  const size_t n = b->count();
+  if (b->states() == nullptr || b->actions() == nullptr || b->rewards() == nullptr || b->next_states() == nullptr ||
+      b->terminals() == nullptr || b->mc_returns() == nullptr) {
+    return false;
+  }
+  if (b->states()->size() != n * obs_dim || b->next_states()->size() != n * obs_dim ||
+      b->actions()->size() != n * action_dim || b->rewards()->size() != n || b->terminals()->size() != n ||
+      b->mc_returns()->size() != n) {
+    return false;
+  }
+  return all_finite(b->states()) && all_finite(b->next_states()) && all_finite(b->actions()) &&
+         all_finite(b->rewards()) && all_finite(b->mc_returns());
+}
+
+TransitionRows rows_of(const TransitionBatch* b) {
+  return {b->count(),
+          b->obs_dim(),
+          b->action_dim(),
+          b->states()->data(),
+          b->actions()->data(),
+          b->rewards()->data(),
+          b->next_states()->data(),
+          b->terminals()->data(),
+          b->mc_returns()->data()};
+}
+
+void build_join_request(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name,
+                        const std::string& shard_insert_endpoint, const std::string& shard_sample_endpoint,
+                        uint32_t actor_envs) {
+  fbb.Clear();
+  const auto n = fbb.CreateString(name);
+  const auto e = fbb.CreateString(shard_insert_endpoint);
+  const auto s = fbb.CreateString(shard_sample_endpoint);
+  finish(fbb, Payload::JoinRequest, CreateJoinRequest(fbb, role, n, e, actor_envs, s).Union());
+}
+
+void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, const std::string& config_toml,
+                       const std::vector<std::string>& shard_insert_endpoints,
+                       const std::vector<std::string>& shard_sample_endpoints, const std::string& weights_endpoint,
+                       uint32_t actor_index, uint32_t num_actors_hint, uint64_t weights_version) {
+  fbb.Clear();
+  const auto cfg = fbb.CreateString(config_toml);
+  const auto inserts = fbb.CreateVectorOfStrings(shard_insert_endpoints);
+  const auto samples = fbb.CreateVectorOfStrings(shard_sample_endpoints);
+  const auto weights = fbb.CreateString(weights_endpoint);
+  finish(fbb, Payload::ClusterMap,
+         CreateClusterMap(fbb, version, cfg, inserts, weights, actor_index, num_actors_hint, weights_version, samples)
+             .Union());
+}
+
+void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
+                            const TransitionRows& rows) {
+  fbb.Clear();
+  finish(fbb, Payload::TransitionBatch, batch_offset(fbb, actor_id, sequence, rows).Union());
+}
+
+void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size) {
+  fbb.Clear();
+  finish(fbb, Payload::SampleRequest, CreateSampleRequest(fbb, request_id, batch_size).Union());
+}
+
+void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows) {
+  fbb.Clear();
+  const auto batch = batch_offset(fbb, 0, request_id, rows);
+  finish(fbb, Payload::SampleReply, CreateSampleReply(fbb, request_id, batch).Union());
+}
+
+void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
+                          std::span<const int> widths, uint8_t bound, std::span<const float> params) {
+  fbb.Clear();
+  const auto w = fbb.CreateVector(widths.data(), widths.size());
+  const auto p = fbb.CreateVector(params.data(), params.size());
+  finish(fbb, Payload::PolicyWeights, CreatePolicyWeights(fbb, version, updates, w, bound, p).Union());
+}
+
+void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,
+                          uint32_t steps, int32_t status, uint64_t policy_version) {
+  fbb.Clear();
+  finish(fbb, Payload::EpisodeReport,
+         CreateEpisodeReport(fbb, kSchemaVersion, actor_id, episode, ret, steps, status, policy_version).Union());
+}
+
+void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,
+                     std::span<const int64_t> counters) {
+  fbb.Clear();
+  const auto n = fbb.CreateString(name);
+  const auto c = fbb.CreateVector(counters.data(), counters.size());
+  finish(fbb, Payload::Heartbeat, CreateHeartbeat(fbb, role, n, map_version, c).Union());
+}
+
+}  // namespace pamdp::wire

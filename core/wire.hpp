@@ -1,0 +1,66 @@
+// The schema layer: the only code that touches generated FlatBuffers types for the protocol
+// (schemas/messages.fbs, docs/protocol.md). Builders write one Envelope into a caller-owned
+// FlatBufferBuilder (Clear()ed and reused, so steady-state sending allocates nothing once the
+// builder has grown); open_envelope() verifies a received buffer before anything reads it.
+#pragma once
+
+#include <flatbuffers/flatbuffers.h>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "schemas/messages_generated.h"
+
+namespace pamdp::wire {
+
+inline constexpr uint16_t kSchemaVersion = 1;
+
+// Returns the envelope if `bytes` is a well-formed, verified Envelope of our schema version,
+// else nullptr (the caller counts and drops it).
+const Envelope* open_envelope(std::span<const uint8_t> bytes);
+
+// The finished buffer of a builder.
+inline std::span<const uint8_t> bytes_of(const flatbuffers::FlatBufferBuilder& fbb) {
+  return {fbb.GetBufferPointer(), fbb.GetSize()};
+}
+
+// Rows of transitions, row-major: states count*obs_dim, actions count*action_dim, ...
+struct TransitionRows {
+  uint32_t count = 0;
+  uint32_t obs_dim = 0;
+  uint32_t action_dim = 0;
+  const float* states = nullptr;
+  const float* actions = nullptr;
+  const float* rewards = nullptr;
+  const float* next_states = nullptr;
+  const uint8_t* terminals = nullptr;
+  const float* mc_returns = nullptr;
+};
+
+// True if every array of `batch` has the sizes its count and the expected widths imply, the
+// count is within max_count, and every float is finite.
+bool valid_batch(const TransitionBatch* batch, uint32_t obs_dim, uint32_t action_dim, uint32_t max_count);
+// Views of a validated batch.
+TransitionRows rows_of(const TransitionBatch* batch);
+
+void build_join_request(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name,
+                        const std::string& shard_insert_endpoint, const std::string& shard_sample_endpoint,
+                        uint32_t actor_envs);
+void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, const std::string& config_toml,
+                       const std::vector<std::string>& shard_insert_endpoints,
+                       const std::vector<std::string>& shard_sample_endpoints, const std::string& weights_endpoint,
+                       uint32_t actor_index, uint32_t num_actors_hint, uint64_t weights_version);
+void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
+                            const TransitionRows& rows);
+void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size);
+void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows);
+void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
+                          std::span<const int> widths, uint8_t bound, std::span<const float> params);
+void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,
+                          uint32_t steps, int32_t status, uint64_t policy_version);
+void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,
+                     std::span<const int64_t> counters);
+
+}  // namespace pamdp::wire
