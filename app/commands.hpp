@@ -7,8 +7,11 @@
 
 namespace pamdp::app {
 
+void register_actor(CLI::App& app);
 void register_eval(CLI::App& app);
 void register_sim(CLI::App& app);
 void register_train(CLI::App& app);
+void register_replay(CLI::App& app);
+void register_learner(CLI::App& app);
 
 }  // namespace pamdp::app

@@ -20,9 +20,12 @@ int run(int argc, char** argv) {
       ->each([](const std::string& level) { pamdp::log::set_level(level); })
       ->capture_default_str();
 
+  pamdp::app::register_actor(app);
   pamdp::app::register_eval(app);
   pamdp::app::register_sim(app);
   pamdp::app::register_train(app);
+  pamdp::app::register_replay(app);
+  pamdp::app::register_learner(app);
 
   std::string valid;
   bool known = false;

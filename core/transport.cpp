@@ -2,7 +2,9 @@
 
 #include <zmq.h>
 
+#include <cstring>
 #include <stdexcept>
+#include <vector>
 #include <zmq.hpp>
 
 namespace pamdp::net {
@@ -44,18 +46,43 @@ void* Context::raw() const {
   return impl_->ctx.handle();
 }
 
+// FlatBuffers reads scalars in place, so a frame must start 8-byte aligned. ZeroMQ's TCP decoder
+// hands out large frames that point into its receive buffer just past the frame header
+// (zero-copy), at any alignment; data() copies those into an aligned buffer that grows once and is
+// then reused. raw() is how every receive reaches the frame, so it marks the copy stale.
 struct Message::Impl {
   zmq::message_t msg;
+  bool settled = false;
+  const uint8_t* data = nullptr;
+  std::vector<uint64_t> aligned;
+
+  void settle() {
+    const auto* p = static_cast<const uint8_t*>(msg.data());
+    data = p;
+    if (reinterpret_cast<uintptr_t>(p) % alignof(uint64_t) != 0) {
+      const size_t words = (msg.size() + sizeof(uint64_t) - 1) / sizeof(uint64_t);
+      if (aligned.size() < words) {
+        aligned.resize(words);
+      }
+      std::memcpy(aligned.data(), p, msg.size());
+      data = reinterpret_cast<const uint8_t*>(aligned.data());
+    }
+    settled = true;
+  }
 };
 Message::Message() : impl_(std::make_unique<Impl>()) {}
 Message::~Message() = default;
 const uint8_t* Message::data() const {
-  return static_cast<const uint8_t*>(impl_->msg.data());
+  if (!impl_->settled) {
+    impl_->settle();
+  }
+  return impl_->data;
 }
 size_t Message::size() const {
   return impl_->msg.size();
 }
 void* Message::raw() {
+  impl_->settled = false;
   return &impl_->msg;
 }
 
@@ -107,6 +134,10 @@ void Socket::set_recv_hwm(int messages) {
 }
 void Socket::set_linger_ms(int ms) {
   setint(raw(), ZMQ_LINGER, ms, "linger");
+}
+void Socket::set_kernel_buffers(int send_bytes, int recv_bytes) {
+  setint(raw(), ZMQ_SNDBUF, send_bytes, "kernel send buffer");
+  setint(raw(), ZMQ_RCVBUF, recv_bytes, "kernel receive buffer");
 }
 void Socket::set_router_mandatory(bool on) {
   setint(raw(), ZMQ_ROUTER_MANDATORY, on ? 1 : 0, "router mandatory");
@@ -236,19 +267,25 @@ bool Socket::wait_readable(int timeout_ms) {
 void Poller::add(Socket& s) {
   sockets_.push_back(s.raw());
   revents_.push_back(0);
+  items_.resize(sockets_.size() * sizeof(zmq_pollitem_t));
+}
+
+void Poller::clear() {
+  sockets_.clear();
+  revents_.clear();
+  items_.clear();
 }
 
 int Poller::poll(int timeout_ms) {
-  std::vector<zmq_pollitem_t> items;
-  items.reserve(sockets_.size());
-  for (void* s : sockets_) {
-    items.push_back({s, 0, ZMQ_POLLIN, 0});
+  auto* items = reinterpret_cast<zmq_pollitem_t*>(items_.data());
+  for (size_t i = 0; i < sockets_.size(); ++i) {
+    items[i] = {sockets_[i], 0, ZMQ_POLLIN, 0};
   }
   int rc = 0;
   do {
-    rc = zmq_poll(items.data(), static_cast<int>(items.size()), timeout_ms);
+    rc = zmq_poll(items, static_cast<int>(sockets_.size()), timeout_ms);
   } while (rc < 0 && zmq_errno() == EINTR);
-  for (size_t i = 0; i < items.size(); ++i) {
+  for (size_t i = 0; i < sockets_.size(); ++i) {
     revents_[i] = items[i].revents;
   }
   return rc < 0 ? 0 : rc;

@@ -3,14 +3,17 @@
 // ipc:// or tcp://, optionally with CURVE encryption and authentication.
 //
 // Threading: a Context may be shared by threads; a Socket belongs to one thread at a time.
-// Costs: send/recv copy nothing beyond what ZeroMQ itself does; Message objects are reused by
-// the caller so that steady-state receiving allocates only inside ZeroMQ.
+// Costs: send/recv copy nothing beyond what ZeroMQ itself does, except that Message::data()
+// copies a frame ZeroMQ delivered at an address not 8-byte aligned (TCP frames, usually) into an
+// aligned buffer, so that FlatBuffers can read it in place; Message objects are reused by the
+// caller so that steady-state receiving allocates only inside ZeroMQ.
 // Errors: setup failures a user can cause (a bad endpoint, a port in use) throw
 // std::runtime_error naming the endpoint and the fix; timeouts are returned as false.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <span>
 #include <string>
@@ -74,6 +77,10 @@ class Socket {
   void set_send_hwm(int messages);
   void set_recv_hwm(int messages);
   void set_linger_ms(int ms);
+  // Kernel socket buffer sizes (SO_SNDBUF / SO_RCVBUF). The high water marks count messages
+  // in ZeroMQ's queues only; on loopback the kernel buffers can hold megabytes more, so tight
+  // backpressure needs both small.
+  void set_kernel_buffers(int send_bytes, int recv_bytes);
   // ROUTER: report unroutable messages as errors instead of dropping them silently.
   void set_router_mandatory(bool on);
   // Largest message accepted; bigger ones make ZeroMQ drop the peer's connection (a cheap first
@@ -111,6 +118,8 @@ class Socket {
 class Poller {
  public:
   void add(Socket& s);
+  void clear();
+  [[nodiscard]] size_t size() const { return sockets_.size(); }
   // Returns how many are readable; readable(i) tells which.
   int poll(int timeout_ms);
   [[nodiscard]] bool readable(size_t index) const;
@@ -118,6 +127,7 @@ class Poller {
  private:
   std::vector<void*> sockets_;
   std::vector<short> revents_;
+  std::vector<std::byte> items_;  // zmq_pollitem_t storage, rebuilt by add(); poll() allocates nothing
 };
 
 // Generates a CURVE key pair (Z85). Throws if libzmq was built without CURVE.

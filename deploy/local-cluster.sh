@@ -1,21 +1,131 @@
 #!/usr/bin/env bash
-# Runs the main job on this machine with the embedded simulator.
+# Runs the main job on this machine: a local actor-learner cluster training DDPG on the embedded
+# HFO simulator. Starts K replay shards, the learner and N actors, shows the learner's progress,
+# and on Ctrl-C stops every process it started, leaving a resumable run directory.
 #
-# For now (until the distributed actor-learner system lands) the main job is the paper's
-# evaluation protocol played by the scripted offense baseline: 100 episodes of 1v0 HFO,
-# printing the paper's table row. Extra arguments go to `pamdp eval`
-# (e.g. --episodes 1000 --seed 7 --json, or --policy random).
-# Builds build/bin/pamdp first if it is missing, installing the Debian packages it needs.
+#   deploy/local-cluster.sh [--actors N] [--shards K] [--config FILE] [--run-dir DIR]
+#                           [--resume DIR] [--port P] [--duration SECONDS] [--set key=value ...]
+#
+# Defaults: one actor per core, 2 shards, deploy/configs/fast.toml, runs/cluster-<time>,
+# learner on 127.0.0.1:5555 (weights on 5556). Builds build/bin/pamdp first if it is missing.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+
+cores=$(nproc 2>/dev/null || echo 2)
+actors=$cores
+shards=2
+config=deploy/configs/fast.toml
+run_dir=""
+resume=""
+port=5555
+duration=0
+sets=()
+
+usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+die() { echo "local-cluster: $*" >&2; exit 2; }
+need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
+
+while [[ $# -gt 0 ]]; do
+  case $1 in
+    --actors) need_value "$@"; actors=$2; shift 2 ;;
+    --shards) need_value "$@"; shards=$2; shift 2 ;;
+    --config) need_value "$@"; config=$2; shift 2 ;;
+    --run-dir) need_value "$@"; run_dir=$2; shift 2 ;;
+    --resume) need_value "$@"; resume=$2; shift 2 ;;
+    --port) need_value "$@"; port=$2; shift 2 ;;
+    --duration) need_value "$@"; duration=$2; shift 2 ;;
+    --set) need_value "$@"; sets+=(--set "$2"); shift 2 ;;
+    -h|--help) usage; exit 0 ;;
+    *) die "unknown option '$1' (see --help)" ;;
+  esac
+done
+[[ $actors =~ ^[0-9]+$ && $actors -ge 1 ]] || die "--actors must be a positive integer, got '$actors'"
+[[ $shards =~ ^[0-9]+$ && $shards -ge 1 ]] || die "--shards must be a positive integer, got '$shards'"
+[[ $port =~ ^[0-9]+$ && $port -ge 1 && $port -le 65534 ]] || die "--port must be within 1..65534, got '$port'"
+[[ $duration =~ ^[0-9]+$ ]] || die "--duration must be a whole number of seconds, got '$duration'"
+if [[ -z $resume ]]; then
+  [[ -f $config ]] || die "config '$config' not found (presets: deploy/configs/*.toml)"
+fi
 
 if [[ ! -x build/bin/pamdp ]]; then
   echo "local-cluster: building build/bin/pamdp (first run)..." >&2
   deploy/install-deps.sh
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build build --target pamdp -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
+  cmake --build build --target pamdp -j "$cores" >/dev/null
 fi
+bin=$root/build/bin/pamdp
 
-echo "local-cluster: scripted offense baseline, paper protocol (100 episodes, embedded HFO 1v0)" >&2
-exec build/bin/pamdp eval --policy scripted --episodes 100 "$@"
+for p in $port $((port + 1)); do
+  if (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
+    die "port $p on 127.0.0.1 is in use (another cluster?); pick others with --port"
+  fi
+done
+
+if [[ -n $resume ]]; then
+  run_dir=$resume
+  [[ -f $run_dir/checkpoint.ckpt ]] || die "--resume $run_dir: no checkpoint.ckpt there"
+  learner_args=(--resume "$run_dir")
+else
+  [[ -n $run_dir ]] || run_dir="runs/cluster-$(date +%Y%m%d-%H%M%S)"
+  [[ ! -e $run_dir/checkpoint.ckpt ]] || die "run directory '$run_dir' already holds a run; continue it with --resume $run_dir"
+  learner_args=(--config "$config" --run-dir "$run_dir")
+fi
+mkdir -p "$run_dir/logs"
+join="tcp://127.0.0.1:$port"
+
+pids=()
+stop_all() {
+  trap - INT TERM EXIT
+  echo
+  echo "local-cluster: stopping ${#pids[@]} processes..." >&2
+  # Actors first (no new data), then the learner (writes its checkpoint), then the shards
+  # (write their snapshots).
+  for pid in "${pids[@]:1+shards}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  kill -TERM "${pids[0]}" 2>/dev/null || true
+  wait "${pids[0]}" 2>/dev/null || true
+  for pid in "${pids[@]:1:shards}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  echo "local-cluster: stopped. Resume with: deploy/local-cluster.sh --resume $run_dir" >&2
+}
+trap stop_all INT TERM EXIT
+
+"$bin" learner "${learner_args[@]}" \
+  --set "cluster.learner_bind=$join" --set "cluster.weights_bind=tcp://127.0.0.1:$((port + 1))" \
+  --set "replay.shards=$shards" "${sets[@]}" >"$run_dir/logs/learner.log" 2>&1 &
+pids+=($!)
+for ((i = 0; i < shards; i++)); do
+  "$bin" replay --join "$join" --insert-bind "tcp://127.0.0.1:0" --sample-bind "tcp://127.0.0.1:0" \
+    --snapshot "$run_dir/shard-$i.replay" >"$run_dir/logs/shard-$i.log" 2>&1 &
+  pids+=($!)
+done
+for ((i = 0; i < actors; i++)); do
+  "$bin" actor --join "$join" --seed $((1000 + i)) >"$run_dir/logs/actor-$i.log" 2>&1 &
+  pids+=($!)
+done
+
+cat <<EOF
+local-cluster: learner + $shards shards + $actors actors on this machine
+  run directory: $run_dir   (config.toml, metrics.csv, episodes.csv, checkpoint.ckpt)
+  logs:          $run_dir/logs/{learner,shard-*,actor-*}.log
+  learner:       $join (weights on tcp://127.0.0.1:$((port + 1)))
+  add an actor:  $bin actor --join $join
+Ctrl-C stops everything and leaves the run resumable.
+EOF
+
+start=$(date +%s)
+tail -n +1 -F "$run_dir/logs/learner.log" 2>/dev/null &
+tail_pid=$!
+while kill -0 "${pids[0]}" 2>/dev/null; do
+  if ((duration > 0 && $(date +%s) - start >= duration)); then
+    break
+  fi
+  sleep 1
+done
+kill "$tail_pid" 2>/dev/null || true
+if ! kill -0 "${pids[0]}" 2>/dev/null; then
+  wait "${pids[0]}" && status=0 || status=$?
+  if ((status != 0)); then
+    echo "local-cluster: the learner exited with status $status; see $run_dir/logs/learner.log" >&2
+  fi
+fi

@@ -1,0 +1,769 @@
+#include "actor/actor_loop.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "core/bounds.hpp"
+#include "core/log.hpp"
+#include "core/mlp.hpp"
+#include "core/rng.hpp"
+#include "core/wire.hpp"
+
+namespace pamdp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr uint8_t kBoundSquashing = 2;  // PolicyWeights.bound: the learner squashes, so must we
+constexpr uint8_t kMaxBound = 2;
+constexpr int64_t kMaxWeightsBytes = int64_t{64} << 20;  // 16M parameters
+constexpr int64_t kMaxShardMessageBytes = 64 << 10;      // shards send actors nothing
+constexpr int kMaxLayerWidth = 1 << 16;
+// Control sockets (weights, learner answers) are looked at this often: often enough that new
+// weights apply within a millisecond, rarely enough that the poll syscalls cost nothing per step.
+constexpr auto kControlPeriod = std::chrono::milliseconds(1);
+// Messages taken from one control socket per look, so that a flooding peer cannot hold the env
+// loop; the rest wait for the next look.
+constexpr int kMaxMessagesPerLook = 64;
+
+int64_t ms_between(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(to - from).count();
+}
+
+uint64_t mix(uint64_t a, uint64_t b) {
+  Rng r(a ^ (b * 0x9E3779B97F4A7C15ULL));
+  return r.next_u64();
+}
+
+size_t area(int rows, int width) {
+  return static_cast<size_t>(rows) * static_cast<size_t>(width);
+}
+
+// Transitions of one env's running episode, kept until it ends so that Monte-Carlo returns can
+// be computed. Sized once for the env's longest episode.
+class EpisodeBuffer {
+ public:
+  EpisodeBuffer(int max_steps, int obs, int act)
+      : obs_(static_cast<size_t>(obs)),
+        act_(static_cast<size_t>(act)),
+        states_(area(max_steps, obs)),
+        next_(area(max_steps, obs)),
+        actions_(area(max_steps, act)),
+        rewards_(static_cast<size_t>(max_steps)),
+        returns_(static_cast<size_t>(max_steps)) {}
+
+  void clear() { n_ = 0; }
+  [[nodiscard]] size_t size() const { return n_; }
+  [[nodiscard]] size_t capacity() const { return rewards_.size(); }
+
+  void push(std::span<const float> s, std::span<const float> a, float r, std::span<const float> s2) {
+    std::copy(s.begin(), s.end(), states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy(a.begin(), a.end(), actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
+    std::copy(s2.begin(), s2.end(), next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    rewards_[n_] = r;
+    ++n_;
+  }
+
+  // G_t = r_t + gamma * G_{t+1}, G after the last step = 0 (in double, as the trainer does).
+  void compute_returns(double gamma) {
+    double g = 0.0;
+    for (size_t i = n_; i-- > 0;) {
+      g = rewards_[i] + gamma * g;
+      returns_[i] = static_cast<float>(g);
+    }
+  }
+
+  [[nodiscard]] const float* state(size_t i) const { return states_.data() + i * obs_; }
+  [[nodiscard]] const float* next_state(size_t i) const { return next_.data() + i * obs_; }
+  [[nodiscard]] const float* action(size_t i) const { return actions_.data() + i * act_; }
+  [[nodiscard]] float reward(size_t i) const { return rewards_[i]; }
+  [[nodiscard]] float mc_return(size_t i) const { return returns_[i]; }
+
+ private:
+  size_t obs_, act_;
+  size_t n_ = 0;
+  std::vector<float> states_, next_, actions_, rewards_, returns_;
+};
+
+// Rows of the next TransitionBatch, row-major as the wire wants them.
+class OutgoingBatch {
+ public:
+  OutgoingBatch(int capacity, int obs, int act)
+      : obs_(static_cast<size_t>(obs)),
+        act_(static_cast<size_t>(act)),
+        states_(area(capacity, obs)),
+        next_(area(capacity, obs)),
+        actions_(area(capacity, act)),
+        rewards_(static_cast<size_t>(capacity)),
+        returns_(static_cast<size_t>(capacity)),
+        terminals_(static_cast<size_t>(capacity)) {}
+
+  [[nodiscard]] bool empty() const { return n_ == 0; }
+  [[nodiscard]] bool full() const { return n_ == rewards_.size(); }
+  void clear() { n_ = 0; }
+
+  void append(const EpisodeBuffer& ep, size_t i, bool terminal) {
+    std::copy_n(ep.state(i), obs_, states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy_n(ep.next_state(i), obs_, next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy_n(ep.action(i), act_, actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
+    rewards_[n_] = ep.reward(i);
+    returns_[n_] = ep.mc_return(i);
+    terminals_[n_] = terminal ? 1 : 0;
+    ++n_;
+  }
+
+  [[nodiscard]] wire::TransitionRows rows() const {
+    return {static_cast<uint32_t>(n_),
+            static_cast<uint32_t>(obs_),
+            static_cast<uint32_t>(act_),
+            states_.data(),
+            actions_.data(),
+            rewards_.data(),
+            next_.data(),
+            terminals_.data(),
+            returns_.data()};
+  }
+
+ private:
+  size_t obs_, act_;
+  size_t n_ = 0;
+  std::vector<float> states_, next_, actions_, rewards_, returns_;
+  std::vector<uint8_t> terminals_;
+};
+
+struct EnvSlot {
+  std::unique_ptr<Env> env;
+  std::vector<float> obs, next_obs, stored;
+  EpisodeBuffer episode;
+  uint64_t seed = 0;
+  uint64_t episodes = 0;
+  double ret = 0.0;
+  int steps = 0;
+
+  EnvSlot(std::unique_ptr<Env> e, int obs_dim, int width, uint64_t s)
+      : env(std::move(e)),
+        obs(static_cast<size_t>(obs_dim)),
+        next_obs(static_cast<size_t>(obs_dim)),
+        stored(static_cast<size_t>(width)),
+        episode(env->max_episode_steps(), obs_dim, width),
+        seed(s) {}
+};
+
+struct Shard {
+  std::string endpoint;
+  net::Socket dealer;
+  std::optional<Clock::time_point> blocked_since;  // first failed send of the current stall
+  std::optional<Clock::time_point> skipped_until;  // out of the rotation until then, then probed
+
+  Shard(net::Context& ctx, std::string ep) : endpoint(std::move(ep)), dealer(ctx, net::SocketType::kDealer) {}
+  [[nodiscard]] bool available(Clock::time_point now) const { return !skipped_until || now >= *skipped_until; }
+};
+
+const Env& first_env(const std::vector<std::unique_ptr<Env>>& envs) {
+  if (envs.empty() || envs.front() == nullptr) {
+    throw std::invalid_argument("ActorLoop: needs at least one env");
+  }
+  const Env& first = *envs.front();
+  for (const auto& e : envs) {
+    if (e == nullptr || e->observation_size() != first.observation_size() ||
+        e->action_space().output_width() != first.action_space().output_width() ||
+        e->action_space().num_actions() != first.action_space().num_actions()) {
+      throw std::invalid_argument("ActorLoop: every env must have the same observation size and action space");
+    }
+  }
+  if (first.max_episode_steps() < 1) {
+    throw std::invalid_argument("ActorLoop: env max_episode_steps() must be at least 1");
+  }
+  return first;
+}
+
+ActorLoopConfig checked(ActorLoopConfig c) {
+  if (c.batch_transitions < 1) {
+    throw std::invalid_argument("ActorLoop: batch_transitions must be at least 1");
+  }
+  if (!(c.gamma >= 0.0 && c.gamma <= 1.0)) {
+    throw std::invalid_argument("ActorLoop: gamma must lie in [0, 1]");
+  }
+  if (c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 || c.send_attempt_ms < 1 || c.tick_ms < 1 || c.shard_send_hwm < 1) {
+    throw std::invalid_argument(
+        "ActorLoop: heartbeat_ms, peer_timeout_ms, send_attempt_ms, tick_ms and shard_send_hwm must be positive");
+  }
+  return c;
+}
+
+}  // namespace
+
+struct ActorLoop::Impl {
+  Impl(net::Context& ctx, LearnerLink link, const ClusterInfo& map, std::vector<std::unique_ptr<Env>> env_list,
+       ActorLoopConfig config, ActorCounters& counters);
+
+  void run(const std::atomic<bool>& stop, const std::function<void(const ActorCounters&, double)>& on_tick);
+
+  void step(EnvSlot& slot);
+  void forward(std::span<const float> obs);
+  void finish_episode(EnvSlot& slot, int status);
+  void reset(EnvSlot& slot);
+
+  void send_batch();
+  bool try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms);
+  Shard* pick_shard(Clock::time_point now);
+  [[nodiscard]] bool another_available(size_t index, Clock::time_point now) const;
+  void final_flush();
+
+  void serve_control(Clock::time_point now);
+  void poll_weights();
+  const wire::PolicyWeights* check_weights(std::span<const uint8_t> bytes);
+  void apply_weights(const wire::PolicyWeights* w);
+  void poll_learner(Clock::time_point now);
+  void apply_map(const ClusterInfo& map);
+  void heartbeat(Clock::time_point now);
+  void drain_shards();
+  void heard_learner(Clock::time_point now);
+  void update_epsilon();
+  void note_malformed(const char* what);
+
+  net::Context& ctx;
+  ActorLoopConfig config;
+  ActorCounters& counters;
+  LearnerLink link;
+
+  // Shapes, fixed by the envs.
+  int obs_dim;
+  int width;
+  int num_actions;
+  OutputBounds bounds;
+  uint32_t actor_index;
+
+  // The cluster as the newest map describes it.
+  uint64_t map_version = 0;
+  uint32_t num_actors_hint = 0;
+  std::string weights_endpoint;
+  std::vector<Shard> shards;
+  size_t next_shard = 0;
+  net::Socket sub;
+  std::array<net::Message, 2> weights_msg;  // newest valid one and the one being received
+  net::Message junk;
+  ClusterInfo incoming_map;
+
+  // Acting.
+  std::vector<EnvSlot> envs;
+  EpsilonGreedy explore;
+  std::unique_ptr<Mlp<float>> policy;  // null until the first PolicyWeights
+  Eigen::MatrixXf input;
+  std::vector<float> net_out;
+  bool squash_output = false;
+  uint64_t weights_version = 0;
+  int64_t updates = 0;
+  double eps = 1.0;
+
+  // Sending.
+  OutgoingBatch batch;
+  flatbuffers::FlatBufferBuilder batch_fbb;
+  uint64_t sequence = 0;
+
+  // Timing and state of the control plane.
+  const std::atomic<bool>* stop = nullptr;
+  const std::function<void(const ActorCounters&, double)>* on_tick = nullptr;
+  Clock::time_point next_control, next_heartbeat, next_tick, learner_heard, rejoin_sent, last_malformed_log;
+  bool rejoin_pending = false;
+  bool learner_silent = false;
+  bool waiting_for_shards_logged = false;
+};
+
+ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
+                      std::vector<std::unique_ptr<Env>> env_list, ActorLoopConfig cfg, ActorCounters& cnt)
+    : ctx(c),
+      config(checked(std::move(cfg))),
+      counters(cnt),
+      link(std::move(l)),
+      obs_dim(first_env(env_list).observation_size()),
+      width(env_list.front()->action_space().output_width()),
+      num_actions(env_list.front()->action_space().num_actions()),
+      bounds(OutputBounds::for_actor(env_list.front()->action_space())),
+      actor_index(map.actor_index),
+      sub(ctx, net::SocketType::kSub),
+      explore(env_list.front()->action_space(), config.exploration, mix(config.seed, 1000 + uint64_t{map.actor_index})),
+      input(obs_dim, 1),
+      net_out(static_cast<size_t>(width)),
+      batch(config.batch_transitions, obs_dim, width),
+      batch_fbb(static_cast<size_t>(config.batch_transitions) * (2 * area(1, obs_dim) + area(1, width) + 3) * 4 +
+                1024) {
+  const uint64_t actor_seed = mix(config.seed, 2000 + uint64_t{actor_index});
+  envs.reserve(env_list.size());
+  for (size_t k = 0; k < env_list.size(); ++k) {
+    envs.emplace_back(std::move(env_list[k]), obs_dim, width, mix(actor_seed, k));
+  }
+  sub.set_max_message_bytes(kMaxWeightsBytes);
+  sub.set_recv_hwm(4);  // only the newest weights matter
+  if (config.curve) {
+    sub.make_curve_client(*config.curve);
+  }
+  sub.subscribe_all();
+  counters.malformed_messages.fetch_add(link.malformed_during_join(), std::memory_order_relaxed);
+  apply_map(map);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Acting
+
+void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
+                          const std::function<void(const ActorCounters&, double)>& tick) {
+  stop = &stop_flag;
+  on_tick = &tick;
+  const auto now = Clock::now();
+  next_control = now;
+  next_heartbeat = now;
+  next_tick = now + std::chrono::milliseconds(config.tick_ms);
+  learner_heard = now;
+  for (EnvSlot& slot : envs) {
+    reset(slot);
+  }
+  log::info("actor {}: stepping {} {} env(s), {} shard(s), batches of {} transitions", actor_index, envs.size(),
+            envs.front().env->name(), shards.size(), config.batch_transitions);
+  size_t k = 0;
+  while (!stop_flag.load(std::memory_order_relaxed)) {
+    const auto t = Clock::now();
+    if (t >= next_control) {
+      serve_control(t);
+    }
+    step(envs[k]);
+    k = k + 1 == envs.size() ? 0 : k + 1;
+  }
+  final_flush();
+  log::info("actor {}: stopped after {} env steps, {} episodes, {} batches", actor_index, counters.env_steps.load(),
+            counters.episodes.load(), counters.batches_sent.load());
+  stop = nullptr;
+  on_tick = nullptr;
+}
+
+void ActorLoop::Impl::reset(EnvSlot& slot) {
+  slot.env->reset(mix(slot.seed, slot.episodes), slot.obs);
+  slot.episode.clear();
+  slot.ret = 0.0;
+  slot.steps = 0;
+}
+
+void ActorLoop::Impl::forward(std::span<const float> obs) {
+  input.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), obs_dim);
+  const auto out = policy->forward(input);
+  const std::span<const float> raw(out.data(), static_cast<size_t>(width));
+  if (squash_output) {
+    squash(raw, bounds, net_out);
+  } else {
+    std::copy(raw.begin(), raw.end(), net_out.begin());
+  }
+}
+
+void ActorLoop::Impl::step(EnvSlot& slot) {
+  // At ε = 1 the network's output is never used, so it is not computed.
+  if (policy != nullptr && eps < 1.0) {
+    forward(slot.obs);
+  }
+  const int id = explore.select(net_out, eps, slot.stored);
+  const StepResult sr = slot.env->step(
+      {id, std::span<const float>(slot.stored).subspan(static_cast<size_t>(num_actions))}, slot.next_obs);
+  slot.episode.push(slot.obs, slot.stored, sr.reward, slot.next_obs);
+  slot.ret += sr.reward;
+  ++slot.steps;
+  std::swap(slot.obs, slot.next_obs);
+  counters.env_steps.fetch_add(1, std::memory_order_relaxed);
+  if (sr.terminal() || slot.episode.size() >= slot.episode.capacity()) {
+    finish_episode(slot, sr.status);
+  }
+}
+
+void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
+  EpisodeBuffer& ep = slot.episode;
+  ep.compute_returns(config.gamma);
+  // Time-outs count as terminals, as in the paper's code and the single-process trainer.
+  for (size_t i = 0; i < ep.size(); ++i) {
+    batch.append(ep, i, i + 1 == ep.size());
+    if (batch.full()) {
+      send_batch();
+    }
+  }
+  ++slot.episodes;
+  const int64_t episode = counters.episodes.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), static_cast<float>(slot.ret),
+                                static_cast<uint32_t>(slot.steps), status, weights_version)) {
+    counters.reports_dropped.fetch_add(1, std::memory_order_relaxed);
+  }
+  reset(slot);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sending
+
+Shard* ActorLoop::Impl::pick_shard(Clock::time_point now) {
+  for (size_t j = 0; j < shards.size(); ++j) {
+    const size_t i = (next_shard + j) % shards.size();
+    if (shards[i].available(now)) {
+      next_shard = i;
+      return &shards[i];
+    }
+  }
+  return nullptr;
+}
+
+bool ActorLoop::Impl::another_available(size_t index, Clock::time_point now) const {
+  for (size_t i = 0; i < shards.size(); ++i) {
+    if (i != index && shards[i].available(now)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// One send attempt to shards[index]; on success the batch is gone and the rotation moves on.
+bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms) {
+  Shard& s = shards[index];
+  if (!s.dealer.send(bytes, timeout_ms)) {
+    return false;
+  }
+  if (s.skipped_until) {
+    log::info("actor {}: shard {} accepts batches again", actor_index, s.endpoint);
+  }
+  s.blocked_since.reset();
+  s.skipped_until.reset();
+  next_shard = (index + 1) % shards.size();
+  ++sequence;
+  counters.batches_sent.fetch_add(1, std::memory_order_relaxed);
+  counters.transitions_sent.fetch_add(batch.rows().count, std::memory_order_relaxed);
+  batch.clear();
+  return true;
+}
+
+// Blocks (serving the control sockets) until a shard takes the batch or stop is set, in which
+// case the batch is dropped.
+void ActorLoop::Impl::send_batch() {
+  wire::build_transition_batch(batch_fbb, actor_index, sequence, batch.rows());
+  const std::span<const uint8_t> bytes = wire::bytes_of(batch_fbb);
+  while (!stop->load(std::memory_order_relaxed)) {
+    const auto now = Clock::now();
+    if (now >= next_control) {
+      serve_control(now);
+    }
+    Shard* target = pick_shard(now);
+    if (target == nullptr) {
+      // No shard in the map, or every one skipped: probe the skipped ones, then wait a slice.
+      for (size_t j = 0; j < shards.size(); ++j) {
+        if (try_send((next_shard + j) % shards.size(), bytes, 0)) {
+          return;
+        }
+      }
+      if (shards.empty() && !waiting_for_shards_logged) {
+        log::warn("actor {}: no replay shard in the cluster map; holding the batch until one joins", actor_index);
+        waiting_for_shards_logged = true;
+      }
+      link.wait_readable(config.send_attempt_ms);
+      counters.send_blocked_ms.fetch_add(ms_between(now, Clock::now()), std::memory_order_relaxed);
+      continue;
+    }
+    const size_t index = next_shard;
+    const bool probing = target->skipped_until.has_value();
+    if (try_send(index, bytes, probing ? 0 : config.send_attempt_ms)) {
+      return;
+    }
+    const auto after = Clock::now();
+    counters.send_blocked_ms.fetch_add(ms_between(now, after), std::memory_order_relaxed);
+    if (probing) {
+      target->skipped_until = after + std::chrono::milliseconds(config.peer_timeout_ms);
+      continue;
+    }
+    if (!target->blocked_since) {
+      target->blocked_since = now;
+    }
+    // A full queue is backpressure and we wait; but if this shard takes nothing for a whole peer
+    // timeout while another could, it is probably gone: skip it (the learner drops a dead shard
+    // from the map within the same timeout, and then we disconnect it for good).
+    if (ms_between(*target->blocked_since, after) >= config.peer_timeout_ms && another_available(index, after)) {
+      log::warn("actor {}: shard {} has taken no batch for {} ms; sending to the other shards", actor_index,
+                target->endpoint, ms_between(*target->blocked_since, after));
+      target->blocked_since.reset();
+      target->skipped_until = after + std::chrono::milliseconds(config.peer_timeout_ms);
+      next_shard = (index + 1) % shards.size();
+    }
+  }
+  batch.clear();
+}
+
+void ActorLoop::Impl::final_flush() {
+  if (batch.empty()) {
+    return;
+  }
+  wire::build_transition_batch(batch_fbb, actor_index, sequence, batch.rows());
+  for (size_t j = 0; j < shards.size(); ++j) {
+    if (try_send((next_shard + j) % shards.size(), wire::bytes_of(batch_fbb), config.send_attempt_ms)) {
+      return;
+    }
+  }
+  batch.clear();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Control plane
+
+void ActorLoop::Impl::serve_control(Clock::time_point now) {
+  next_control = now + kControlPeriod;
+  poll_weights();
+  poll_learner(now);
+  if (now >= next_heartbeat) {
+    heartbeat(now);
+    next_heartbeat = now + std::chrono::milliseconds(config.heartbeat_ms);
+  }
+  if (now >= next_tick) {
+    next_tick = now + std::chrono::milliseconds(config.tick_ms);
+    if (on_tick != nullptr && *on_tick) {
+      (*on_tick)(counters, eps);
+    }
+  }
+}
+
+void ActorLoop::Impl::note_malformed(const char* what) {
+  const int64_t n = counters.malformed_messages.fetch_add(1, std::memory_order_relaxed) + 1;
+  const auto now = Clock::now();
+  if (n == 1 || ms_between(last_malformed_log, now) >= 1000) {
+    last_malformed_log = now;
+    log::warn("actor {}: dropped a malformed message ({}); {} so far", actor_index, what, n);
+  }
+}
+
+const wire::PolicyWeights* ActorLoop::Impl::check_weights(std::span<const uint8_t> bytes) {
+  const wire::Envelope* env = wire::open_envelope(bytes);
+  if (env == nullptr || env->payload_type() != wire::Payload::PolicyWeights) {
+    note_malformed("weights socket: not a verified PolicyWeights");
+    return nullptr;
+  }
+  const wire::PolicyWeights* w = env->payload_as_PolicyWeights();
+  const auto* widths = w->widths();
+  if (widths == nullptr || widths->size() < 2 || widths->Get(0) != obs_dim ||
+      widths->Get(widths->size() - 1) != width) {
+    note_malformed("PolicyWeights: widths do not fit this env's observation and action widths");
+    return nullptr;
+  }
+  int64_t expected = 0;
+  for (flatbuffers::uoffset_t l = 0; l < widths->size(); ++l) {
+    const int wl = widths->Get(l);
+    if (wl < 1 || wl > kMaxLayerWidth) {
+      note_malformed("PolicyWeights: a layer width out of range");
+      return nullptr;
+    }
+    if (l > 0) {
+      expected += int64_t{widths->Get(l - 1)} * wl + wl;
+    }
+  }
+  if (w->params() == nullptr || static_cast<int64_t>(w->params()->size()) != expected || w->bound() > kMaxBound) {
+    note_malformed("PolicyWeights: parameter count does not match the widths, or an unknown bound");
+    return nullptr;
+  }
+  const float* p = w->params()->data();
+  if (!std::all_of(p, p + expected, [](float v) { return std::isfinite(v); })) {
+    note_malformed("PolicyWeights: a parameter is not finite");
+    return nullptr;
+  }
+  return w;
+}
+
+void ActorLoop::Impl::poll_weights() {
+  int pending = -1;  // index into weights_msg of the newest valid weights, if any
+  for (int n = 0; n < kMaxMessagesPerLook; ++n) {
+    const int slot = pending == 0 ? 1 : 0;
+    if (!sub.recv(weights_msg[static_cast<size_t>(slot)], 0)) {
+      break;
+    }
+    if (check_weights(weights_msg[static_cast<size_t>(slot)].bytes()) != nullptr) {
+      pending = slot;
+    }
+  }
+  if (pending >= 0) {
+    const wire::Envelope* env = wire::open_envelope(weights_msg[static_cast<size_t>(pending)].bytes());
+    apply_weights(env->payload_as_PolicyWeights());
+  }
+}
+
+void ActorLoop::Impl::apply_weights(const wire::PolicyWeights* w) {
+  const auto* widths = w->widths();
+  bool same_shape = policy != nullptr && policy->widths().size() == widths->size();
+  for (flatbuffers::uoffset_t l = 0; same_shape && l < widths->size(); ++l) {
+    same_shape = policy->widths()[l] == widths->Get(l);
+  }
+  const bool first = policy == nullptr;
+  if (!same_shape) {
+    // Only on the first weights (or a learner restarted with other hidden widths): not per step.
+    policy = std::make_unique<Mlp<float>>(std::vector<int>(widths->begin(), widths->end()), 1);
+  }
+  std::copy_n(w->params()->data(), w->params()->size(), policy->params().data());
+  squash_output = w->bound() == kBoundSquashing;
+  weights_version = w->version();
+  updates = w->updates();
+  counters.weights_version.store(static_cast<int64_t>(weights_version), std::memory_order_relaxed);
+  update_epsilon();
+  if (first) {
+    log::info("actor {}: first weights (version {}, {} learner updates, {} parameters); epsilon {:.3f}", actor_index,
+              weights_version, updates, policy->num_params(), eps);
+  }
+}
+
+void ActorLoop::Impl::update_epsilon() {
+  const ExplorationConfig& e = config.exploration;
+  if (policy == nullptr) {
+    eps = 1.0;
+  } else if (config.apex_epsilon) {
+    const auto n = static_cast<int>(std::max(num_actors_hint, actor_index + 1));
+    eps = apex_epsilon(static_cast<int>(actor_index), n, config.apex_base, config.apex_alpha);
+  } else {
+    eps = linear_epsilon(updates, e.epsilon_start, e.epsilon_end, e.epsilon_anneal_updates);
+  }
+}
+
+void ActorLoop::Impl::heard_learner(Clock::time_point now) {
+  learner_heard = now;
+  if (learner_silent) {
+    log::info("actor {}: the learner answers again", actor_index);
+    learner_silent = false;
+  }
+}
+
+void ActorLoop::Impl::poll_learner(Clock::time_point now) {
+  for (int n = 0; n < kMaxMessagesPerLook; ++n) {
+    uint64_t learner_version = 0;
+    switch (link.receive(incoming_map, learner_version)) {
+      case LearnerLink::Received::kNothing: return;
+      case LearnerLink::Received::kMalformed:
+        note_malformed("join socket: not a verified ClusterMap or Heartbeat");
+        break;
+      case LearnerLink::Received::kHeartbeat:
+        heard_learner(now);
+        // A different version is a newer map, or a restarted learner: ask for the map again
+        // (and again after a peer timeout if the answer got lost).
+        if (learner_version != map_version &&
+            (!rejoin_pending || ms_between(rejoin_sent, now) >= config.peer_timeout_ms)) {
+          log::info("actor {}: the learner's map is version {}, ours {}; re-joining", actor_index, learner_version,
+                    map_version);
+          link.send_join_request();
+          rejoin_pending = true;
+          rejoin_sent = now;
+        }
+        break;
+      case LearnerLink::Received::kClusterMap:
+        heard_learner(now);
+        apply_map(incoming_map);
+        rejoin_pending = false;
+        break;
+    }
+  }
+}
+
+void ActorLoop::Impl::apply_map(const ClusterInfo& map) {
+  const bool had_shards = !shards.empty();
+  map_version = map.version;
+  num_actors_hint = map.num_actors_hint;
+  if (map.actor_index != actor_index) {
+    // The index we were first given stays ours: it seeds our streams, picks our ε and tags
+    // our batches; a learner that hands out a new index per join does not change it.
+    log::debug("actor {}: the map names us actor {}; keeping {}", actor_index, map.actor_index, actor_index);
+  }
+  if (map.weights_endpoint != weights_endpoint) {
+    try {
+      if (!weights_endpoint.empty()) {
+        sub.disconnect(weights_endpoint);
+      }
+      sub.connect(map.weights_endpoint);
+      weights_endpoint = map.weights_endpoint;
+    } catch (const std::runtime_error& e) {
+      note_malformed("cluster map: weights endpoint cannot be connected");
+      log::warn("actor {}: {}", actor_index, e.what());
+    }
+  }
+  std::vector<Shard> next;
+  next.reserve(map.shard_endpoints.size());
+  for (const std::string& ep : map.shard_endpoints) {
+    auto it = std::find_if(shards.begin(), shards.end(), [&](const Shard& s) { return s.endpoint == ep; });
+    if (it != shards.end()) {
+      next.push_back(std::move(*it));
+      it->endpoint.clear();  // moved; not reported as removed below
+      continue;
+    }
+    try {
+      Shard s(ctx, ep);
+      s.dealer.set_send_hwm(config.shard_send_hwm);
+      // Keep the kernel from buffering megabytes of transitions behind the high water mark:
+      // backpressure from a rate-limited shard should reach the env loop within a few batches.
+      s.dealer.set_kernel_buffers(1 << 16, 1 << 16);
+      s.dealer.set_max_message_bytes(kMaxShardMessageBytes);
+      if (config.curve) {
+        s.dealer.make_curve_client(*config.curve);
+      }
+      s.dealer.connect(ep);
+      next.push_back(std::move(s));
+      log::info("actor {}: sending to shard {}", actor_index, ep);
+    } catch (const std::runtime_error& e) {
+      note_malformed("cluster map: shard endpoint cannot be connected");
+      log::warn("actor {}: {}", actor_index, e.what());
+    }
+  }
+  for (const Shard& s : shards) {
+    if (!s.endpoint.empty()) {
+      log::info("actor {}: shard {} left the map; disconnecting", actor_index, s.endpoint);
+    }
+  }
+  shards = std::move(next);
+  if (!shards.empty()) {
+    next_shard = had_shards ? next_shard % shards.size() : actor_index % shards.size();
+    waiting_for_shards_logged = false;
+  }
+  update_epsilon();
+}
+
+void ActorLoop::Impl::heartbeat(Clock::time_point now) {
+  const std::array<int64_t, 7> c{counters.env_steps.load(std::memory_order_relaxed),
+                                 counters.episodes.load(std::memory_order_relaxed),
+                                 counters.batches_sent.load(std::memory_order_relaxed),
+                                 counters.transitions_sent.load(std::memory_order_relaxed),
+                                 counters.weights_version.load(std::memory_order_relaxed),
+                                 counters.malformed_messages.load(std::memory_order_relaxed),
+                                 counters.send_blocked_ms.load(std::memory_order_relaxed)};
+  link.send_heartbeat(map_version, c);
+  drain_shards();
+  if (!learner_silent && ms_between(learner_heard, now) > config.peer_timeout_ms) {
+    log::warn("actor {}: no answer from the learner for {} ms; acting on with weights version {}", actor_index,
+              ms_between(learner_heard, now), weights_version);
+    learner_silent = true;
+  }
+}
+
+void ActorLoop::Impl::drain_shards() {
+  for (Shard& s : shards) {
+    for (int n = 0; n < kMaxMessagesPerLook && s.dealer.recv(junk, 0); ++n) {
+      note_malformed("a shard sent something to an actor");
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+ActorLoop::ActorLoop(net::Context& ctx, LearnerLink link, const ClusterInfo& map,
+                     std::vector<std::unique_ptr<Env>> envs, ActorLoopConfig config, ActorCounters& counters)
+    : impl_(std::make_unique<Impl>(ctx, std::move(link), map, std::move(envs), std::move(config), counters)) {}
+
+ActorLoop::~ActorLoop() = default;
+
+void ActorLoop::run(const std::atomic<bool>& stop) {
+  impl_->run(stop, on_tick);
+}
+
+uint32_t ActorLoop::actor_index() const {
+  return impl_->actor_index;
+}
+
+double ActorLoop::epsilon() const {
+  return impl_->eps;
+}
+
+}  // namespace pamdp

@@ -1,0 +1,149 @@
+// `pamdp actor`: joins a learner, takes the experiment config from its cluster map, builds the
+// envs and runs the acting loop (actor/actor_loop.hpp) until SIGINT or SIGTERM.
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "actor/actor_loop.hpp"
+#include "actor/learner_link.hpp"
+#include "app/commands.hpp"
+#include "app/env_factory.hpp"
+#include "app/experiment_config.hpp"
+#include "core/log.hpp"
+#include "core/transport.hpp"
+
+namespace pamdp::app {
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_actor_signal(int /*sig*/) {
+  g_stop.store(true);
+}
+
+struct ActorCliOptions {
+  std::string join;
+  int envs = 1;
+  int64_t seed = -1;
+  bool apex_epsilon = false;
+  std::string name;
+  double join_timeout_s = 0.0;
+  double progress_every_s = 5.0;
+};
+
+std::string default_name() {
+  char host[256] = {};
+  if (gethostname(host, sizeof(host) - 1) != 0) {
+    host[0] = '\0';
+  }
+  return std::string(host[0] != '\0' ? host : "actor") + ":" + std::to_string(getpid());
+}
+
+void run_actor(const ActorCliOptions& o) {
+  std::signal(SIGINT, on_actor_signal);
+  std::signal(SIGTERM, on_actor_signal);
+  net::Context ctx;
+  LearnerLinkConfig link_config;
+  link_config.join_endpoint = o.join;
+  link_config.name = o.name.empty() ? default_name() : o.name;
+  link_config.actor_envs = static_cast<uint32_t>(o.envs);
+  link_config.join_timeout_ms = static_cast<int>(o.join_timeout_s * 1000.0);
+  LearnerLink link(ctx, link_config);
+  const std::optional<ClusterInfo> map = link.join(g_stop);
+  if (!map) {
+    if (g_stop.load()) {
+      return;
+    }
+    throw std::runtime_error("no cluster map from the learner at " + o.join + " within " +
+                             std::to_string(o.join_timeout_s) +
+                             " s; start `pamdp learner` first or check the address (--join tcp://HOST:PORT)");
+  }
+  const ExperimentConfig config = parse_experiment_config(map->config_toml, "the cluster map from " + o.join, {});
+
+  std::vector<std::unique_ptr<Env>> envs;
+  envs.reserve(static_cast<size_t>(o.envs));
+  for (int k = 0; k < o.envs; ++k) {
+    envs.push_back(make_env(config.env));
+  }
+  ActorLoopConfig loop_config;
+  loop_config.exploration = resolve_exploration(config, envs.front()->action_space());
+  loop_config.gamma = config.ddpg.gamma;
+  loop_config.batch_transitions = config.cluster.actor_batch_transitions;
+  loop_config.heartbeat_ms = config.cluster.heartbeat_ms;
+  loop_config.peer_timeout_ms = config.cluster.peer_timeout_ms;
+  loop_config.apex_epsilon = o.apex_epsilon;
+  loop_config.seed = o.seed >= 0 ? static_cast<uint64_t>(o.seed) : config.seed;
+  if (config.cluster.curve) {
+    throw std::runtime_error(
+        "cluster.curve = true, but pamdp actor has no CURVE client keys option yet; run the cluster without CURVE");
+  }
+
+  ActorCounters counters;
+  ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  int64_t last_steps = 0;
+  loop.on_tick = [&](const ActorCounters& c, double eps) {
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    if (dt < o.progress_every_s) {
+      return;
+    }
+    const int64_t steps = c.env_steps.load();
+    std::printf(
+        "[%7.1fs] actor %u | %.0f steps/s | steps %lld | episodes %lld | weights v%lld | eps %.3f | batches %lld | "
+        "blocked %.1f s | malformed %lld\n",
+        std::chrono::duration<double>(now - start).count(), loop.actor_index(),
+        static_cast<double>(steps - last_steps) / dt, static_cast<long long>(steps),
+        static_cast<long long>(c.episodes.load()), static_cast<long long>(c.weights_version.load()), eps,
+        static_cast<long long>(c.batches_sent.load()), static_cast<double>(c.send_blocked_ms.load()) / 1000.0,
+        static_cast<long long>(c.malformed_messages.load()));
+    std::fflush(stdout);
+    last = now;
+    last_steps = steps;
+  };
+  std::printf("pamdp actor: actor %u, %d %s env(s), %zu shard(s), learner %s\n", loop.actor_index(), o.envs,
+              config.env.name.c_str(), map->shard_endpoints.size(), o.join.c_str());
+  std::fflush(stdout);
+  loop.run(g_stop);
+  std::printf("done: %lld env steps, %lld episodes, %lld batches (%lld transitions) sent, weights v%lld\n",
+              static_cast<long long>(counters.env_steps.load()), static_cast<long long>(counters.episodes.load()),
+              static_cast<long long>(counters.batches_sent.load()),
+              static_cast<long long>(counters.transitions_sent.load()),
+              static_cast<long long>(counters.weights_version.load()));
+}
+
+}  // namespace
+
+void register_actor(CLI::App& app) {
+  auto o = std::make_shared<ActorCliOptions>();
+  CLI::App* cmd = app.add_subcommand("actor", "act in envs for a distributed learner (docs/protocol.md)");
+  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")->required();
+  cmd->add_option("--envs", o->envs, "environments stepped round robin")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "random seed (default: the experiment's seed), mixed with the actor index")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--apex-epsilon", o->apex_epsilon,
+                "per-actor fixed epsilon 0.4^(1 + 7 i / (N - 1)) (Ape-X) instead of the learner's schedule");
+  cmd->add_option("--name", o->name, "name in the learner's logs (default HOST:PID)");
+  cmd->add_option("--join-timeout", o->join_timeout_s, "give up joining after this many seconds (0: keep trying)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--progress-every", o->progress_every_s, "seconds between progress lines")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--log-level", "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->each([](const std::string& level) { log::set_level(level); });
+  cmd->callback([o] { run_actor(*o); });
+}
+
+}  // namespace pamdp::app

@@ -1,0 +1,247 @@
+// `pamdp learner`: the learner process of the distributed system (docs/protocol.md).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/actor_policy.hpp"
+#include "app/commands.hpp"
+#include "app/env_factory.hpp"
+#include "app/experiment_config.hpp"
+#include "core/files.hpp"
+#include "core/log.hpp"
+#include "core/transport.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/evaluation.hpp"
+#include "learner/learner_server.hpp"
+
+namespace pamdp::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+LearnerServer* g_server = nullptr;
+extern "C" void on_learner_signal(int /*sig*/) {
+  if (g_server != nullptr) {
+    g_server->stop();
+  }
+}
+
+struct LearnerCliOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  int64_t seed = -1;
+  std::string run_dir;
+  std::string resume;
+  bool quiet = false;
+};
+
+void run_learner(const LearnerCliOptions& o) {
+  ExperimentConfig c;
+  std::string run_dir;
+  const bool resume = !o.resume.empty();
+  if (resume) {
+    if (!o.config.empty()) {
+      throw std::runtime_error("--resume uses the config saved in the run directory; drop --config");
+    }
+    run_dir = o.resume;
+    if (!fs::exists(fs::path(run_dir) / "config.toml") || !fs::exists(fs::path(run_dir) / "checkpoint.ckpt")) {
+      throw std::runtime_error("--resume " + run_dir + ": no config.toml and checkpoint.ckpt there");
+    }
+    c = load_experiment_config((fs::path(run_dir) / "config.toml").string(), o.sets);
+  } else {
+    c = load_experiment_config(o.config, o.sets);
+    if (o.seed >= 0) {
+      c.seed = static_cast<uint64_t>(o.seed);
+    }
+    if (o.run_dir.empty()) {
+      const std::time_t t = std::time(nullptr);
+      char stamp[32];
+      std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&t));
+      run_dir = "runs/" + std::string(stamp) + "-cluster-seed" + std::to_string(c.seed);
+    } else {
+      run_dir = o.run_dir;
+    }
+    if (fs::exists(fs::path(run_dir) / "checkpoint.ckpt")) {
+      throw std::runtime_error("run directory '" + run_dir + "' already holds a run; use --resume " + run_dir);
+    }
+  }
+  if (c.cluster.curve) {
+    throw std::runtime_error("cluster.curve = true: CURVE keys are not supported by this build yet; set it to false");
+  }
+  fs::create_directories(run_dir);
+  const std::string config_text = to_toml(c);
+  if (!resume) {
+    write_file_atomically((fs::path(run_dir) / "config.toml").string(), config_text.data(), config_text.size());
+  }
+
+  auto env = make_env(c.env);
+  auto eval_env = make_env(c.env);
+  const ExplorationConfig exploration = resolve_exploration(c, env->action_space());
+  Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
+  CheckpointMeta meta;
+  if (resume) {
+    meta = load_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg);
+  }
+  meta.config_toml = config_text;
+
+  LearnerServerConfig sc;
+  sc.join_bind = c.cluster.learner_bind;
+  sc.weights_bind = c.cluster.weights_bind;
+  sc.advertise_host = c.cluster.advertise_host;
+  sc.config_toml = config_text;
+  sc.publish_every_updates = c.cluster.publish_every_updates;
+  sc.requests_in_flight_per_shard = c.cluster.requests_in_flight_per_shard;
+  sc.heartbeat_ms = c.cluster.heartbeat_ms;
+  sc.peer_timeout_ms = c.cluster.peer_timeout_ms;
+  sc.max_updates = c.train.max_updates;
+  sc.max_seconds = c.train.max_seconds;
+
+  net::Context ctx;
+  LearnerServer server(ctx, ddpg, sc);
+  g_server = &server;
+  std::signal(SIGINT, on_learner_signal);
+  std::signal(SIGTERM, on_learner_signal);
+
+  std::ofstream metrics(fs::path(run_dir) / "metrics.csv", std::ios::app);
+  std::ofstream episodes(fs::path(run_dir) / "episodes.csv", std::ios::app);
+  if (!metrics || !episodes) {
+    throw std::runtime_error("cannot write metrics into run directory '" + run_dir + "'");
+  }
+  if (fs::file_size(fs::path(run_dir) / "metrics.csv") == 0) {
+    metrics << "wall_seconds,updates,episodes,success_rate_100,mean_return_100,mean_steps_100,critic_loss,q_mean,"
+               "updates_per_s,samples_per_s,shards,actors_joined,weights_version,malformed_messages,"
+               "waiting_for_data_ms,eval_success_rate,eval_avg_steps_to_success,eval_avg_return\n";
+    episodes << "episode,wall_seconds,updates,actor,return,steps,status\n";
+  }
+
+  struct Recent {
+    float ret;
+    uint32_t steps;
+    bool success;
+  };
+  std::deque<Recent> recent;
+  UpdateStats last_stats;
+  EvalResult last_eval;
+  bool have_eval = false;
+  const auto start = std::chrono::steady_clock::now();
+  const double base_seconds = meta.elapsed_seconds;
+  auto elapsed = [&] {
+    return base_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  double last_checkpoint = elapsed();
+  int64_t last_updates = ddpg.updates();
+  int64_t last_samples = 0;
+  double last_tick = elapsed();
+  int64_t episode_count = meta.episodes;
+  double last_print = -1e9;
+
+  auto save = [&] {
+    meta.elapsed_seconds = elapsed();
+    meta.episodes = episode_count;
+    save_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg, meta);
+    last_checkpoint = elapsed();
+  };
+
+  server.on_episode = [&](const EpisodeSummary& e) {
+    ++episode_count;
+    const bool success = e.status == env->success_status();
+    recent.push_back({e.ret, e.steps, success});
+    if (recent.size() > 100) {
+      recent.pop_front();
+    }
+    episodes << episode_count << ',' << elapsed() << ',' << ddpg.updates() << ',' << e.actor_id << ',' << e.ret << ','
+             << e.steps << ',' << env->status_name(e.status) << '\n';
+  };
+  server.on_update = [&](const UpdateStats& s) {
+    last_stats = s;
+    const int64_t every = c.train.eval_every_updates;
+    if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
+      GreedyActorPolicy policy(ddpg, env->action_space(), exploration);
+      last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
+      have_eval = true;
+    }
+  };
+  server.on_tick = [&](const LearnerCounters& k) {
+    const double now = elapsed();
+    const double dt = std::max(1e-9, now - last_tick);
+    const double ups = static_cast<double>(ddpg.updates() - last_updates) / dt;
+    const double sps = static_cast<double>(k.samples_received - last_samples) / dt;
+    last_tick = now;
+    last_updates = ddpg.updates();
+    last_samples = k.samples_received;
+    double ret = 0.0;
+    double steps = 0.0;
+    int goals = 0;
+    for (const auto& r : recent) {
+      ret += r.ret;
+      steps += r.steps;
+      goals += r.success ? 1 : 0;
+    }
+    const double n = std::max<double>(1.0, static_cast<double>(recent.size()));
+    if (now - last_checkpoint >= c.train.checkpoint_every_seconds && c.train.checkpoint_every_seconds > 0) {
+      save();
+    }
+    metrics << now << ',' << ddpg.updates() << ',' << episode_count << ',' << goals / n << ',' << ret / n << ','
+            << steps / n << ',' << last_stats.critic_loss << ',' << last_stats.q_mean << ',' << ups << ',' << sps << ','
+            << k.shards << ',' << k.actors_joined << ',' << k.weights_version << ',' << k.malformed_messages << ','
+            << k.waiting_for_data_ms << ',';
+    if (have_eval) {
+      metrics << last_eval.goal_rate << ',' << last_eval.avg_steps_to_goal << ',' << last_eval.avg_return;
+    } else {
+      metrics << ",,";
+    }
+    metrics << '\n' << std::flush;
+    episodes << std::flush;
+    if (!o.quiet && now - last_print >= c.train.log_every_seconds) {
+      last_print = now;
+      std::printf(
+          "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | %.0f updates/s | %.0f "
+          "samples/s | shards %lld | actors %lld | weights v%lld%s%s\n",
+          now, static_cast<long long>(ddpg.updates()), static_cast<long long>(episode_count), recent.size(), goals / n,
+          ret / n, ups, sps, static_cast<long long>(k.shards), static_cast<long long>(k.actors_joined),
+          static_cast<long long>(k.weights_version), k.shards == 0 ? " | waiting: no replay shard has joined" : "",
+          (k.shards > 0 && ups == 0.0) ? " | waiting: shards have too little data (warm-up / rate limit)" : "");
+      std::fflush(stdout);
+    }
+  };
+
+  if (!o.quiet) {
+    std::printf("pamdp learner: env %s, run directory %s%s\n  join:    %s\n  weights: %s\n", c.env.name.c_str(),
+                run_dir.c_str(), resume ? " (resumed)" : "", server.join_endpoint().c_str(),
+                server.weights_endpoint().c_str());
+    std::fflush(stdout);
+  }
+  server.run();
+  server.on_tick(server.counters());  // a last metrics row with the final counters
+  save();
+  g_server = nullptr;
+  std::printf("learner stopped: %lld updates, %lld episodes; checkpoint %s/checkpoint.ckpt\n",
+              static_cast<long long>(ddpg.updates()), static_cast<long long>(episode_count), run_dir.c_str());
+}
+
+}  // namespace
+
+void register_learner(CLI::App& app) {
+  auto o = std::make_shared<LearnerCliOptions>();
+  CLI::App* cmd = app.add_subcommand("learner",
+                                     "the learner of the distributed system: samples replay shards, "
+                                     "runs DDPG updates, broadcasts weights");
+  cmd->add_option("--config", o->config, "TOML config (default: the paper preset)");
+  cmd->add_option("--set", o->sets, "override one config key, e.g. --set cluster.learner_bind=tcp://*:6000");
+  cmd->add_option("--seed", o->seed, "random seed (overrides the config's seed)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--run-dir", o->run_dir, "where config, metrics and checkpoints go");
+  cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
+  cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->callback([o] { run_learner(*o); });
+}
+
+}  // namespace pamdp::app

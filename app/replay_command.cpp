@@ -1,0 +1,140 @@
+#include "app/replay_command.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/env_factory.hpp"
+#include "core/log.hpp"
+#include "core/transport.hpp"
+
+namespace pamdp::app {
+namespace {
+
+// A signal may arrive before the server exists; the flag covers that window.
+std::atomic<bool> g_stop_requested{false};
+std::atomic<ShardServer*> g_server{nullptr};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<ShardServer*>::is_always_lock_free,
+              "the signal handler needs lock-free atomics");
+
+extern "C" void on_replay_signal(int /*sig*/) {
+  g_stop_requested.store(true);
+  if (ShardServer* s = g_server.load()) {
+    s->stop();
+  }
+}
+
+struct ReplayCliOptions {
+  std::string join;
+  std::string insert_bind = "tcp://*:0";
+  std::string sample_bind = "tcp://*:0";
+  std::string advertise_host = "127.0.0.1";
+  std::string snapshot;
+  std::string name;
+};
+
+std::string default_name() {
+  char host[256] = {};
+  if (gethostname(host, sizeof(host) - 1) != 0) {
+    host[0] = '\0';
+  }
+  return "replay@" + std::string(host[0] != '\0' ? host : "localhost") + ":" + std::to_string(getpid());
+}
+
+void run_replay(const ReplayCliOptions& o) {
+  ShardServerOptions options;
+  options.join_endpoint = o.join;
+  options.insert_bind = o.insert_bind;
+  options.sample_bind = o.sample_bind;
+  options.advertise_host = o.advertise_host;
+  options.snapshot_path = o.snapshot;
+  options.name = o.name.empty() ? default_name() : o.name;
+
+  net::Context ctx;
+  ShardServer server(ctx, options, shard_config_from_toml);
+  std::printf("pamdp replay: inserts at %s, samples at %s; joining the learner at %s\n",
+              server.insert_endpoint().c_str(), server.sample_endpoint().c_str(), o.join.c_str());
+  std::fflush(stdout);
+
+  g_server.store(&server);
+  std::signal(SIGINT, on_replay_signal);
+  std::signal(SIGTERM, on_replay_signal);
+  if (g_stop_requested.load()) {
+    server.stop();
+  }
+  try {
+    server.run();
+  } catch (...) {
+    g_server.store(nullptr);
+    throw;
+  }
+  g_server.store(nullptr);
+  const ShardCounters c = server.counters();
+  std::printf("pamdp replay: stopped; %lld transitions inserted, %lld sampled, %lld held, %lld malformed messages\n",
+              static_cast<long long>(c.inserted), static_cast<long long>(c.sampled), static_cast<long long>(c.size),
+              static_cast<long long>(c.malformed));
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+ShardConfig shard_config_from_experiment(const ExperimentConfig& config) {
+  if (config.cluster.curve) {
+    throw std::runtime_error("cluster.curve = true: CURVE keys are not supported by pamdp replay yet; set it to false");
+  }
+  const int64_t shards = config.replay.shards;
+  ShardConfig s;
+  s.capacity = config.replay.capacity / shards;
+  if (s.capacity < 1) {
+    throw std::runtime_error("replay.capacity " + std::to_string(config.replay.capacity) +
+                             " split over replay.shards " + std::to_string(shards) +
+                             " leaves no room per shard; raise replay.capacity");
+  }
+  const std::unique_ptr<Env> env = make_env(config.env);
+  s.obs_dim = env->observation_size();
+  s.action_dim = env->action_space().output_width();
+  s.limiter.samples_per_insert = config.cluster.samples_per_insert > 0.0
+                                     ? config.cluster.samples_per_insert
+                                     : config.train.updates_per_step * static_cast<double>(config.ddpg.batch_size);
+  if (!(s.limiter.samples_per_insert > 0.0)) {
+    throw std::runtime_error(
+        "samples per insert is 0: set cluster.samples_per_insert, or train.updates_per_step and ddpg.batch_size > 0");
+  }
+  s.limiter.min_size = config.replay.warmup / shards;
+  s.limiter.slack = config.cluster.rate_limit_slack;
+  s.seed = config.seed;
+  s.heartbeat_ms = config.cluster.heartbeat_ms;
+  s.peer_timeout_ms = config.cluster.peer_timeout_ms;
+  return s;
+}
+
+ShardConfig shard_config_from_toml(const std::string& config_toml) {
+  return shard_config_from_experiment(parse_experiment_config(config_toml, "the learner's cluster map", {}));
+}
+
+void register_replay(CLI::App& app) {
+  auto o = std::make_shared<ReplayCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "replay", "run one replay shard: joins the learner, stores actors' transitions, serves the learner's samples");
+  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")->required();
+  cmd->add_option("--insert-bind", o->insert_bind, "where actors insert (ROUTER); port 0 = any free port")
+      ->capture_default_str();
+  cmd->add_option("--sample-bind", o->sample_bind, "where the learner samples (ROUTER); port 0 = any free port")
+      ->capture_default_str();
+  cmd->add_option("--advertise-host", o->advertise_host, "the host name peers use to reach this machine's ports")
+      ->capture_default_str();
+  cmd->add_option("--snapshot", o->snapshot,
+                  "replay snapshot file: loaded when the shard starts (if present), written when it stops");
+  cmd->add_option("--name", o->name, "name in the learner's logs (default replay@HOST:PID)");
+  // Lets the global --log-level come after the subcommand name too.
+  cmd->fallthrough();
+  cmd->callback([o] { run_replay(*o); });
+}
+
+}  // namespace pamdp::app

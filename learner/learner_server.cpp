@@ -1,0 +1,326 @@
+#include "learner/learner_server.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/log.hpp"
+#include "core/wire.hpp"
+
+namespace pamdp {
+
+struct FbbHolder {
+  flatbuffers::FlatBufferBuilder fbb{1 << 16};
+  flatbuffers::FlatBufferBuilder weights{1 << 22};
+};
+
+struct LearnerServer::Shard {
+  std::string insert_endpoint;
+  std::string sample_endpoint;
+  std::vector<uint8_t> join_identity;  // the shard's DEALER identity on our join socket
+  net::Socket dealer;
+  int in_flight = 0;
+  std::chrono::steady_clock::time_point last_heard;
+  int64_t samples = 0;
+  Shard(net::Context& ctx) : dealer(ctx, net::SocketType::kDealer) {}
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int64_t ms_since(Clock::time_point t) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t).count();
+}
+
+}  // namespace
+
+LearnerServer::LearnerServer(net::Context& ctx, Ddpg& ddpg, LearnerServerConfig config)
+    : ctx_(ctx),
+      ddpg_(ddpg),
+      config_(std::move(config)),
+      join_(ctx, net::SocketType::kRouter),
+      weights_(ctx, net::SocketType::kPub),
+      fbb_(std::make_unique<FbbHolder>()) {
+  // A join socket peer can send at most a JoinRequest, heartbeats and episode reports: small.
+  join_.set_max_message_bytes(1 << 20);
+  join_.set_recv_hwm(10000);
+  weights_.set_send_hwm(4);  // slow subscribers get the newest weights, not a backlog
+  if (config_.curve) {
+    join_.make_curve_server(*config_.curve);
+    weights_.make_curve_server(*config_.curve);
+  }
+  join_endpoint_ = connectable(join_.bind(config_.join_bind));
+  weights_endpoint_ = connectable(weights_.bind(config_.weights_bind));
+}
+
+LearnerServer::~LearnerServer() = default;
+
+std::string LearnerServer::connectable(const std::string& bound) const {
+  // tcp://0.0.0.0:PORT (from tcp://*:PORT) is not an address a peer can use.
+  const std::string wildcard = "tcp://0.0.0.0:";
+  if (bound.rfind(wildcard, 0) == 0) {
+    return "tcp://" + config_.advertise_host + ":" + bound.substr(wildcard.size());
+  }
+  return bound;
+}
+
+void LearnerServer::note_malformed(const char* what) {
+  ++counters_.malformed_messages;
+  if (ms_since(last_malformed_log_) >= 1000) {
+    last_malformed_log_ = Clock::now();
+    log::warn("learner: dropped a malformed message ({}); {} so far", what, counters_.malformed_messages);
+  }
+}
+
+void LearnerServer::send_map(std::span<const uint8_t> identity, uint32_t actor_index) {
+  std::vector<std::string> inserts;
+  std::vector<std::string> samples;
+  for (const auto& s : shards_) {
+    inserts.push_back(s->insert_endpoint);
+    samples.push_back(s->sample_endpoint);
+  }
+  wire::build_cluster_map(fbb_->fbb, map_version_, config_.config_toml, inserts, samples, weights_endpoint_,
+                          actor_index, next_actor_index_, static_cast<uint64_t>(counters_.weights_version));
+  join_.send_to(identity, wire::bytes_of(fbb_->fbb), 100);
+}
+
+void LearnerServer::publish_weights() {
+  Mlp<float>& actor = ddpg_.actor();
+  ++counters_.weights_version;
+  wire::build_policy_weights(fbb_->weights, static_cast<uint64_t>(counters_.weights_version), ddpg_.updates(),
+                             actor.widths(), static_cast<uint8_t>(ddpg_.config().bound), actor.params());
+  weights_.send(wire::bytes_of(fbb_->weights), 0);
+  last_published_at_ = ddpg_.updates();
+}
+
+void LearnerServer::handle_join_socket() {
+  net::Message identity;
+  net::Message payload;
+  while (join_.recv_from(identity, payload, 0)) {
+    const wire::Envelope* env = wire::open_envelope(payload.bytes());
+    if (env == nullptr) {
+      note_malformed("join socket: not a verified envelope");
+      continue;
+    }
+    const std::vector<uint8_t> id(identity.data(), identity.data() + identity.size());
+    switch (env->payload_type()) {
+      case wire::Payload::JoinRequest: {
+        const auto* j = env->payload_as_JoinRequest();
+        if (j->role() == wire::Role::Shard) {
+          if (j->shard_endpoint() == nullptr || j->shard_sample_endpoint() == nullptr ||
+              j->shard_endpoint()->size() == 0 || j->shard_sample_endpoint()->size() == 0) {
+            note_malformed("shard JoinRequest without endpoints");
+            continue;
+          }
+          const std::string insert = j->shard_endpoint()->str();
+          const std::string sample = j->shard_sample_endpoint()->str();
+          auto it =
+              std::find_if(shards_.begin(), shards_.end(), [&](const auto& s) { return s->insert_endpoint == insert; });
+          if (it != shards_.end() && (*it)->sample_endpoint != sample) {
+            shards_.erase(it);  // same insert address, new process: start over
+            it = shards_.end();
+          }
+          if (it == shards_.end()) {
+            auto shard = std::make_unique<Shard>(ctx_);
+            shard->insert_endpoint = insert;
+            shard->sample_endpoint = sample;
+            shard->dealer.set_max_message_bytes(64 << 20);
+            if (config_.curve_client) {
+              shard->dealer.make_curve_client(*config_.curve_client);
+            }
+            shard->dealer.connect(sample);
+            shards_.push_back(std::move(shard));
+            ++map_version_;
+            log::info("learner: shard joined: insert {} sample {} ({} shards)", insert, sample, shards_.size());
+            it = std::prev(shards_.end());
+          }
+          (*it)->join_identity = id;
+          (*it)->last_heard = Clock::now();
+          send_map(identity.bytes(), 0);
+        } else if (j->role() == wire::Role::Actor) {
+          // An actor that joins again (its map went stale) keeps its index.
+          auto known = actor_index_.find(id);
+          if (known == actor_index_.end()) {
+            known = actor_index_.emplace(id, next_actor_index_++).first;
+            ++counters_.actors_joined;
+            log::info("learner: actor {} joined ({}, {} envs)", known->second, j->name() ? j->name()->str() : "?",
+                      j->actor_envs());
+          }
+          send_map(identity.bytes(), known->second);
+          // The newcomer subscribes only after it has the map: publish again shortly.
+          republish_at_ = Clock::now() + std::chrono::milliseconds(200);
+        } else {
+          note_malformed("JoinRequest from an unexpected role");
+        }
+        break;
+      }
+      case wire::Payload::Heartbeat: {
+        for (auto& s : shards_) {
+          if (s->join_identity == id) {
+            s->last_heard = Clock::now();
+          }
+        }
+        const int64_t c[] = {counters_.updates, counters_.weights_version};
+        wire::build_heartbeat(fbb_->fbb, wire::Role::Learner, "learner", map_version_, c);
+        join_.send_to(identity.bytes(), wire::bytes_of(fbb_->fbb), 0);
+        break;
+      }
+      case wire::Payload::EpisodeReport: {
+        const auto* r = env->payload_as_EpisodeReport();
+        ++counters_.episodes;
+        if (on_episode) {
+          on_episode({r->actor_id(), r->return_(), r->steps(), r->status()});
+        }
+        break;
+      }
+      default: note_malformed("unexpected message type on the join socket"); break;
+    }
+  }
+}
+
+void LearnerServer::request_samples(Shard& shard) {
+  while (shard.in_flight < config_.requests_in_flight_per_shard) {
+    wire::build_sample_request(fbb_->fbb, next_request_id_++, static_cast<uint32_t>(ddpg_.config().batch_size));
+    if (!shard.dealer.send(wire::bytes_of(fbb_->fbb), 0)) {
+      return;
+    }
+    ++shard.in_flight;
+  }
+}
+
+void LearnerServer::handle_shard(Shard& shard) {
+  net::Message& msg = reply_;  // reused: its aligned copy buffer grows once
+  const auto obs = static_cast<uint32_t>(ddpg_.obs_dim());
+  const auto act = static_cast<uint32_t>(ddpg_.output_width());
+  const int B = ddpg_.config().batch_size;
+  std::vector<float>& terminal = terminal_scratch_;
+  // At most one reply per call: the run loop alternates shards and the join socket, so
+  // heartbeats and episode reports are answered between updates.
+  if (shard.dealer.recv(msg, 0)) {
+    shard.in_flight = std::max(0, shard.in_flight - 1);
+    shard.last_heard = Clock::now();
+    const wire::Envelope* env = wire::open_envelope(msg.bytes());
+    if (env == nullptr || env->payload_type() != wire::Payload::SampleReply) {
+      note_malformed("shard reply is not a SampleReply");
+      return;
+    }
+    const wire::TransitionBatch* b = env->payload_as_SampleReply()->batch();
+    if (!wire::valid_batch(b, obs, act, static_cast<uint32_t>(B)) || b->count() != static_cast<uint32_t>(B)) {
+      note_malformed("SampleReply with wrong sizes");
+      return;
+    }
+    // Ask for the next batch before updating, so the shard works while we do.
+    request_samples(shard);
+    const wire::TransitionRows rows = wire::rows_of(b);
+    for (int i = 0; i < B; ++i) {
+      terminal[static_cast<size_t>(i)] = rows.terminals[i] != 0 ? 1.0F : 0.0F;
+    }
+    const BatchView view{
+        Eigen::Map<const Eigen::MatrixXf>(rows.states, obs, B),
+        Eigen::Map<const Eigen::MatrixXf>(rows.actions, act, B),
+        Eigen::Map<const Eigen::VectorXf>(rows.rewards, B),
+        Eigen::Map<const Eigen::MatrixXf>(rows.next_states, obs, B),
+        Eigen::Map<const Eigen::VectorXf>(terminal.data(), B),
+        Eigen::Map<const Eigen::VectorXf>(rows.mc_returns, B),
+    };
+    const UpdateStats stats = ddpg_.update(view);
+    ++counters_.updates;
+    counters_.samples_received += B;
+    shard.samples += B;
+    if (on_update) {
+      on_update(stats);
+    }
+    if (ddpg_.updates() - last_published_at_ >= config_.publish_every_updates) {
+      publish_weights();
+    }
+    if (stop_.load() || ddpg_.updates() >= config_.max_updates) {
+      return;
+    }
+  }
+}
+
+void LearnerServer::drop_dead_shards() {
+  const auto before = shards_.size();
+  std::erase_if(shards_, [&](const auto& s) {
+    if (ms_since(s->last_heard) > config_.peer_timeout_ms) {
+      log::warn("learner: shard {} silent for {} ms; sampling from the others until it rejoins", s->insert_endpoint,
+                ms_since(s->last_heard));
+      return true;
+    }
+    return false;
+  });
+  if (shards_.size() != before) {
+    ++map_version_;
+  }
+}
+
+void LearnerServer::run() {
+  terminal_scratch_.assign(static_cast<size_t>(ddpg_.config().batch_size), 0.0F);
+  const auto start = Clock::now();
+  auto last_tick = start;
+  auto waiting_since = Clock::now();
+  bool waiting = false;
+  last_published_at_ = ddpg_.updates();
+  publish_weights();
+  net::Poller poller;
+  uint64_t poller_version = 0;
+  log::info("learner: join {} weights {}", join_endpoint_, weights_endpoint_);
+  while (!stop_.load() && ddpg_.updates() < config_.max_updates) {
+    if (config_.max_seconds > 0.0 &&
+        std::chrono::duration<double>(Clock::now() - start).count() >= config_.max_seconds) {
+      break;
+    }
+    if (poller.size() != shards_.size() + 1 || poller_version != map_version_) {
+      poller.clear();
+      poller.add(join_);
+      for (auto& s : shards_) {
+        poller.add(s->dealer);
+      }
+      poller_version = map_version_;
+    }
+    const int64_t before = ddpg_.updates();
+    const size_t polled = shards_.size();
+    poller.poll(20);
+    // Shards first: handling the join socket may add or replace shards.
+    for (size_t i = 0; i < polled; ++i) {
+      if (poller.readable(i + 1)) {
+        handle_shard(*shards_[i]);
+      }
+    }
+    if (poller.readable(0)) {
+      handle_join_socket();
+    }
+    for (auto& s : shards_) {
+      request_samples(*s);
+    }
+    drop_dead_shards();
+    if (republish_at_ && Clock::now() >= *republish_at_) {
+      republish_at_.reset();
+      publish_weights();
+    }
+    // Waiting-for-data accounting: no update in this round although we tried.
+    if (ddpg_.updates() == before) {
+      if (!waiting) {
+        waiting = true;
+        waiting_since = Clock::now();
+      }
+    } else if (waiting) {
+      counters_.waiting_for_data_ms += ms_since(waiting_since);
+      waiting = false;
+    }
+    if (ms_since(last_tick) >= 1000) {
+      last_tick = Clock::now();
+      counters_.shards = static_cast<int64_t>(shards_.size());
+      if (waiting) {
+        counters_.waiting_for_data_ms += ms_since(waiting_since);
+        waiting_since = Clock::now();
+      }
+      if (on_tick) {
+        on_tick(counters_);
+      }
+    }
+  }
+  publish_weights();
+}
+
+}  // namespace pamdp

@@ -1,0 +1,118 @@
+// The learner role of the distributed system (docs/protocol.md): binds the join socket
+// (ROUTER) and the weights broadcast (PUB), hands out the cluster map, keeps several sample
+// requests in flight on every replay shard, runs DDPG updates on the replies, publishes weights
+// every N updates, and collects episode reports.
+//
+// One thread runs run(); stop() may be called from any thread or a signal handler. Received
+// buffers are verified before use; a bad message is counted and dropped. The update path reads
+// sampled rows in place from the received buffers (row-major rows are the column-major
+// obs x batch matrices Ddpg wants), so it copies nothing per sample.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/transport.hpp"
+#include "learner/ddpg.hpp"
+
+namespace pamdp {
+
+struct FbbHolder;
+
+struct LearnerServerConfig {
+  std::string join_bind = "tcp://*:5555";
+  std::string weights_bind = "tcp://*:5556";
+  std::string advertise_host = "127.0.0.1";
+  std::string config_toml;  // handed to every peer in the cluster map
+  int64_t publish_every_updates = 100;
+  int requests_in_flight_per_shard = 2;
+  int heartbeat_ms = 1000;
+  int peer_timeout_ms = 5000;
+  int64_t max_updates = INT64_MAX;
+  double max_seconds = 0.0;                          // 0 = no limit
+  std::optional<net::CurveServerKeys> curve;         // CURVE on both bound sockets when set
+  std::optional<net::CurveClientKeys> curve_client;  // for the learner's own connections to shards
+};
+
+struct LearnerCounters {
+  int64_t updates = 0;
+  int64_t samples_received = 0;
+  int64_t malformed_messages = 0;
+  int64_t episodes = 0;
+  int64_t weights_version = 0;
+  int64_t shards = 0;
+  int64_t actors_joined = 0;
+  int64_t waiting_for_data_ms = 0;
+};
+
+struct EpisodeSummary {
+  uint32_t actor_id;
+  float ret;
+  uint32_t steps;
+  int32_t status;
+};
+
+class LearnerServer {
+ public:
+  // `ddpg` is owned by the caller and must outlive the server.
+  LearnerServer(net::Context& ctx, Ddpg& ddpg, LearnerServerConfig config);
+  ~LearnerServer();
+
+  // Resolved, connectable endpoints (valid after construction).
+  [[nodiscard]] const std::string& join_endpoint() const { return join_endpoint_; }
+  [[nodiscard]] const std::string& weights_endpoint() const { return weights_endpoint_; }
+
+  // Called on the learner thread: after every update (for logging, checkpoints) and for every
+  // episode report. Either may be empty.
+  std::function<void(const UpdateStats&)> on_update;
+  std::function<void(const EpisodeSummary&)> on_episode;
+  // Called about once per second with the counters (progress lines, metrics).
+  std::function<void(const LearnerCounters&)> on_tick;
+
+  // Runs until stop(), max_updates or max_seconds.
+  void run();
+  void stop() { stop_.store(true); }
+  [[nodiscard]] const LearnerCounters& counters() const { return counters_; }
+  void publish_weights();
+
+ private:
+  struct Shard;
+  void handle_join_socket();
+  void handle_shard(Shard& shard);
+  void request_samples(Shard& shard);
+  void drop_dead_shards();
+  void send_map(std::span<const uint8_t> identity, uint32_t actor_index);
+  std::string connectable(const std::string& bound) const;
+  void note_malformed(const char* what);
+
+  net::Context& ctx_;
+  Ddpg& ddpg_;
+  LearnerServerConfig config_;
+  net::Socket join_;
+  net::Socket weights_;
+  std::string join_endpoint_;
+  std::string weights_endpoint_;
+  std::vector<std::unique_ptr<Shard>> shards_;
+  uint64_t map_version_ = 1;
+  uint64_t next_request_id_ = 1;
+  uint32_t next_actor_index_ = 0;
+  std::map<std::vector<uint8_t>, uint32_t> actor_index_;  // join-socket identity -> actor index
+  LearnerCounters counters_;
+  std::atomic<bool> stop_{false};
+  std::chrono::steady_clock::time_point last_malformed_log_{};
+  std::unique_ptr<FbbHolder> fbb_;
+  int64_t last_published_at_ = -1;
+  std::vector<float> terminal_scratch_;
+  net::Message reply_;
+  std::optional<std::chrono::steady_clock::time_point> republish_at_;
+};
+
+}  // namespace pamdp

@@ -1,0 +1,226 @@
+// The replay shard of the distributed system (docs/protocol.md, "Replay").
+//
+// ReplayShard: the storage and pacing of one shard, a FIFO ReplayBuffer behind a RateLimiter.
+// Memory for the ring and for the largest reply is allocated in the constructor; insert() and
+// sample() copy floats and allocate nothing. Not thread-safe.
+//
+// ShardServer: one thread's event loop around a ReplayShard. It binds a ROUTER "insert"
+// (TransitionBatch from actors, no answer) and a ROUTER "sample" (SampleRequest from the
+// learner, SampleReply possibly later), and keeps a DEALER on the learner's join socket
+// (JoinRequest until a ClusterMap comes, then Heartbeat every heartbeat_ms; it joins again when
+// the learner answers with another map version or stays silent for peer_timeout_ms). The shard
+// itself is built from the first ClusterMap's config_toml through a caller-given function, so
+// this library knows nothing of TOML or experiment configs. A later map with another capacity
+// or other widths rebuilds the shard (dropping its data); other rate settings apply at once,
+// with the limiter's counters kept.
+//   - Every received frame is verified (wire::open_envelope, payload type, wire::valid_batch);
+//     a bad one is dropped, counted (malformed) and logged at most once per second per kind.
+//   - Backpressure: while the rate limiter holds inserts back the insert socket is not read, so
+//     the actors' DEALER queues fill and their sends block. Sample requests that cannot be
+//     served yet wait in a FIFO queue of at most kMaxWaitingRequests; while it is full the
+//     sample socket is not read either.
+//   - Steady-state inserting and sampling allocate nothing (one reused FlatBufferBuilder, a
+//     preallocated reply and request queue; ZeroMQ mallocs message bodies internally):
+//     tests/replay_alloc_test.cpp counts operator new on the shard's thread.
+//   - Cost per TransitionBatch of n rows: verify + validate (one pass over the floats) and one
+//     copy into the ring; per SampleReply of n rows: n random rows copied twice (ring ->
+//     reply scratch -> builder) and one send.
+//   - Snapshot: when a path is set, the shard loads it (if the file exists) when it is built and
+//     writes it when run() returns.
+// Threading: construct on any thread, then run() on one thread; destroy only after run() has
+// returned. stop() and counters() may be called from any thread; stop() is async-signal-safe.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "core/transport.hpp"
+#include "core/wire.hpp"
+#include "replay/rate_limiter.hpp"
+#include "replay/replay_buffer.hpp"
+
+namespace pamdp {
+
+// Everything about a shard that the experiment (the learner's ClusterMap) decides.
+struct ShardConfig {
+  int64_t capacity = 0;  // transitions (replay.capacity / replay.shards)
+  int obs_dim = 0;
+  int action_dim = 0;  // the full actor output vector
+  RateLimiterConfig limiter;
+  uint64_t seed = 1;  // sampling stream (the server mixes in its endpoint)
+  int heartbeat_ms = 1000;
+  int peer_timeout_ms = 5000;
+  bool operator==(const ShardConfig&) const = default;
+};
+
+class ReplayShard {
+ public:
+  // Allocates capacity rows and a reply of up to max_sample_batch rows. Throws
+  // std::invalid_argument if a size is < 1.
+  ReplayShard(const ShardConfig& config, int max_sample_batch);
+
+  [[nodiscard]] bool can_insert(int64_t n) const { return limiter_.can_insert(n); }
+  // Also false while the shard is empty. n must be in [1, max_sample_batch].
+  [[nodiscard]] bool can_sample(int64_t n) const;
+  // Stores validated rows (wire::valid_batch with this shard's widths). Requires
+  // can_insert(rows.count); misuse aborts.
+  void insert(const wire::TransitionRows& rows);
+  // Draws n transitions uniformly with replacement. Requires can_sample(n). The rows view the
+  // shard's reply scratch and stay valid until the next sample().
+  wire::TransitionRows sample(int n);
+
+  // Loads a snapshot written by save_snapshot (throws std::runtime_error naming the file and
+  // the problem: unreadable, corrupt, other capacity or widths). The limiter resumes balanced:
+  // the stored transitions count as inserts (past the warm-up) and as many samples as the
+  // ratio allows, so sampling continues at the ratio instead of replaying old data at will.
+  void load_snapshot(const std::string& path);
+  void save_snapshot(const std::string& path) const;  // atomic write; throws on I/O errors
+  // Keeps the counters, changes the ratio (a new ClusterMap with other limiter settings).
+  void set_limiter_config(const RateLimiterConfig& config);
+
+  [[nodiscard]] const ShardConfig& config() const { return config_; }
+  [[nodiscard]] const ReplayBuffer& buffer() const { return buffer_; }
+  [[nodiscard]] const RateLimiter& limiter() const { return limiter_; }
+  [[nodiscard]] int max_sample_batch() const { return max_sample_batch_; }
+
+ private:
+  ShardConfig config_;
+  int max_sample_batch_;
+  ReplayBuffer buffer_;
+  RateLimiter limiter_;
+  Rng rng_;
+  BatchBuffers reply_;              // column per sample = row-major rows on the wire
+  std::vector<uint8_t> terminals_;  // the wire's 0/1 bytes
+};
+
+struct ShardServerOptions {
+  std::string join_endpoint;  // the learner's join ROUTER, e.g. tcp://learner:5555 (required)
+  std::string insert_bind = "tcp://*:0";
+  std::string sample_bind = "tcp://*:0";
+  std::string advertise_host = "127.0.0.1";  // replaces * / 0.0.0.0 in the advertised endpoints
+  std::string name = "replay";               // for the learner's logs
+  std::string snapshot_path;                 // empty: no snapshot
+  uint32_t max_batch_transitions = 4096;     // largest TransitionBatch and SampleRequest accepted
+  int join_retry_ms = 1000;                  // JoinRequest cadence until the first ClusterMap
+  int poll_ms = 50;                          // the longest stop() waits to be noticed
+  int insert_recv_hwm = 16;                  // batches ZeroMQ queues per actor before its sends block
+  // Frames above this size make ZeroMQ drop the sender's connection before anything reads them.
+  // Fixed at bind time, before the widths are known (a 4096-row HFO batch is 2.1 MB).
+  int64_t max_insert_message_bytes = int64_t{8} << 20;
+};
+
+// Counters, readable from any thread (each field is read atomically, not all together).
+struct ShardCounters {
+  int64_t inserted = 0;           // transitions stored by this process
+  int64_t sampled = 0;            // transitions drawn for replies
+  int64_t malformed = 0;          // messages dropped as malformed, all sockets
+  int64_t requests_waiting = 0;   // sample requests queued now
+  int64_t insert_blocked_ms = 0;  // time the rate limiter held inserts back
+  int64_t replies_dropped = 0;    // replies ZeroMQ could not queue (learner gone or stalled)
+  int64_t size = 0;               // transitions held now
+  int64_t map_version = 0;        // of the last ClusterMap; 0 before joining
+  int64_t joins = 0;              // ClusterMaps taken (1 + re-joins)
+};
+
+// Builds the shard settings from a ClusterMap's config_toml; throws std::runtime_error if the
+// config does not describe a usable shard. Called on the server's thread.
+using ShardConfigFromMap = std::function<ShardConfig(const std::string& config_toml)>;
+
+class ShardServer {
+ public:
+  static constexpr int kMaxWaitingRequests = 64;
+
+  // Binds both ROUTERs and connects to the learner. Throws std::runtime_error for a bad
+  // endpoint or a port in use. `ctx` must outlive the server.
+  ShardServer(net::Context& ctx, ShardServerOptions options, ShardConfigFromMap config_from_map);
+  ~ShardServer();
+  ShardServer(const ShardServer&) = delete;
+  ShardServer& operator=(const ShardServer&) = delete;
+
+  // Connectable endpoints as advertised to the learner (valid after construction).
+  [[nodiscard]] const std::string& insert_endpoint() const { return insert_endpoint_; }
+  [[nodiscard]] const std::string& sample_endpoint() const { return sample_endpoint_; }
+
+  // Serves until stop(); call once. Throws std::runtime_error if the learner's first config
+  // does not describe a shard (a later one that does not is logged and ignored), or if the
+  // snapshot cannot be read (wrong shape, corrupt) or written.
+  void run();
+  void stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
+  [[nodiscard]] ShardCounters counters() const;
+
+  // Heartbeat.counters layout sent to the learner.
+  enum HeartbeatCounter { kHbInserted, kHbSampled, kHbMalformed, kHbWaiting, kHbBlockedMs, kHbSize, kHbCount };
+
+ private:
+  struct WaitingRequest {
+    std::array<uint8_t, 256> identity{};  // ZeroMQ routing ids are at most 255 bytes
+    uint8_t identity_size = 0;
+    uint64_t request_id = 0;
+    uint32_t batch_size = 0;
+  };
+  // Once-per-second logging per kind of event, with the number of events in between.
+  struct LogGate {
+    std::chrono::steady_clock::duration interval = std::chrono::seconds(1);
+    std::optional<std::chrono::steady_clock::time_point> last;
+    int64_t suppressed = 0;  // events since the last line
+    bool open(std::chrono::steady_clock::time_point now);
+  };
+  using Clock = std::chrono::steady_clock;
+
+  void send_join(Clock::time_point now);
+  void send_heartbeat(Clock::time_point now);
+  void read_join_socket(Clock::time_point now);
+  void take_cluster_map(const wire::ClusterMap& map, Clock::time_point now);
+  void read_insert_socket(Clock::time_point now);
+  void read_sample_socket(Clock::time_point now);
+  void serve_waiting_requests(Clock::time_point now);
+  void malformed(LogGate& gate, const char* socket, const char* why, Clock::time_point now);
+  void publish_counters();
+
+  ShardServerOptions options_;
+  ShardConfigFromMap config_from_map_;
+  net::Socket insert_;
+  net::Socket sample_;
+  net::Socket join_;
+  std::string insert_endpoint_;
+  std::string sample_endpoint_;
+  // One poller per set of sockets worth reading: join always, insert only while the limiter
+  // admits inserts, sample only while the waiting queue has room.
+  net::Poller poll_all_, poll_join_insert_, poll_join_sample_, poll_join_;
+
+  std::unique_ptr<ReplayShard> shard_;
+  flatbuffers::FlatBufferBuilder fbb_{1 << 16};
+  net::Message identity_;
+  net::Message frame_;
+  std::array<WaitingRequest, kMaxWaitingRequests> waiting_{};
+  int waiting_head_ = 0;
+  int waiting_count_ = 0;
+
+  bool joined_ = false;
+  uint64_t map_version_ = 0;
+  int heartbeat_ms_ = 1000;
+  int peer_timeout_ms_ = 5000;
+  Clock::time_point next_join_{};
+  Clock::time_point next_heartbeat_{};
+  Clock::time_point last_heard_learner_{};
+  Clock::time_point last_tick_{};
+  bool inserts_held_ = false;
+  Clock::duration blocked_{};
+  LogGate log_insert_, log_sample_, log_join_, log_reply_, log_waiting_, log_silent_;
+  std::array<int64_t, kHbCount> hb_counters_{};
+
+  std::atomic<bool> stop_{false};
+  bool ran_ = false;
+  std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
+      size_{0}, map_version_pub_{0}, joins_{0};
+};
+
+}  // namespace pamdp

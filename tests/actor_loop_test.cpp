@@ -1,0 +1,380 @@
+// actor/: the join handshake, the acting loop and its wire traffic against a fake learner and
+// fake replay shards (tests/actor_harness.hpp), over loopback TCP with ports read back.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "actor_harness.hpp"
+
+namespace pamdp::testing {
+namespace {
+
+// All rows of the batches in sequence order (one shard, so arrival order is sequence order).
+BatchCopy concat(const std::vector<BatchCopy>& batches) {
+  BatchCopy all;
+  for (const BatchCopy& b : batches) {
+    all.count += b.count;
+    all.states.insert(all.states.end(), b.states.begin(), b.states.end());
+    all.next_states.insert(all.next_states.end(), b.next_states.begin(), b.next_states.end());
+    all.actions.insert(all.actions.end(), b.actions.begin(), b.actions.end());
+    all.rewards.insert(all.rewards.end(), b.rewards.begin(), b.rewards.end());
+    all.returns.insert(all.returns.end(), b.returns.begin(), b.returns.end());
+    all.terminals.insert(all.terminals.end(), b.terminals.begin(), b.terminals.end());
+  }
+  return all;
+}
+
+Bytes weights_message(uint64_t version, int64_t updates, uint8_t bound, const std::vector<float>& params,
+                      std::span<const int> widths = kTestWidths) {
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_policy_weights(fbb, version, updates, widths, bound, params);
+  return copy_bytes(wire::bytes_of(fbb));
+}
+
+// Publishes `msg` until the actor shows weights version `version` (PUB/SUB drops what is sent
+// before the subscription is connected, so the first publication may be lost).
+bool publish_until_applied(FakeLearner& learner, std::vector<FakeShard*> shards, ActorRunner& actor, const Bytes& msg,
+                           int64_t version) {
+  return serve_until(learner, std::move(shards), [&] {
+    if (actor.counters.weights_version.load() >= version) {
+      return true;
+    }
+    learner.publish(msg);
+    return false;
+  });
+}
+
+TEST(ActorLoop, JoinsAndShipsTransitionsWithMonteCarloReturnsAndEpisodeReports) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  learner.actor_index = 5;
+  const ActorLoopConfig config = test_loop_config();
+  ActorRunner actor(ctx, learner.join_endpoint(), config, /*envs=*/2);
+
+  ASSERT_TRUE(
+      serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 20 && learner.reports.size() >= 50; }));
+  EXPECT_EQ(shard.invalid, 0);
+  ASSERT_GE(learner.joins.size(), 1U);
+  EXPECT_EQ(learner.joins[0].role, wire::Role::Actor);
+  EXPECT_EQ(learner.joins[0].name, "test-actor");
+  EXPECT_EQ(learner.joins[0].actor_envs, 2U);
+  EXPECT_TRUE(actor.running.load());
+  EXPECT_EQ(actor.config_toml, kConfigToml);  // handed through to the caller untouched
+
+  for (size_t i = 0; i < shard.batches.size(); ++i) {
+    EXPECT_EQ(shard.batches[i].sequence, i);
+    EXPECT_EQ(shard.batches[i].actor_id, 5U);
+    EXPECT_EQ(shard.batches[i].count, 64U);  // full batches while running
+  }
+
+  // Episodes are contiguous runs of rows ending in a terminal row.
+  const BatchCopy rows = concat(shard.batches);
+  const auto gamma = static_cast<float>(config.gamma);
+  std::vector<std::pair<size_t, size_t>> episodes;  // [begin, end)
+  size_t begin = 0;
+  for (size_t t = 0; t < rows.count; ++t) {
+    if (rows.terminals[t] != 0) {
+      episodes.emplace_back(begin, t + 1);
+      begin = t + 1;
+    }
+  }
+  ASSERT_GE(episodes.size(), 30U);
+  for (const auto& [b, e] : episodes) {
+    ASSERT_LE(e - b, 20U) << "ReachStop ends every episode within max_steps = 20";
+    // G_t = r_t + gamma * G_{t+1}; the terminal row's return is its reward.
+    EXPECT_FLOAT_EQ(rows.returns[e - 1], rows.rewards[e - 1]);
+    for (size_t t = b; t + 1 < e; ++t) {
+      EXPECT_NEAR(rows.returns[t], rows.rewards[t] + gamma * rows.returns[t + 1], 1e-5);
+      EXPECT_EQ(rows.terminals[t], 0);
+      for (uint32_t k = 0; k < kObs; ++k) {
+        EXPECT_EQ(rows.next_states[t * kObs + k], rows.states[(t + 1) * kObs + k]) << "row " << t;
+      }
+    }
+  }
+  // Without weights the actor acts at random (ε = 1): scores and velocity in [-1, 1], varied.
+  float lo = 1.0F;
+  float hi = -1.0F;
+  for (const float a : rows.actions) {
+    ASSERT_GE(a, -1.0F);
+    ASSERT_LE(a, 1.0F);
+    lo = std::min(lo, a);
+    hi = std::max(hi, a);
+  }
+  EXPECT_LT(lo, -0.9F);
+  EXPECT_GT(hi, 0.9F);
+  EXPECT_EQ(actor.counters.weights_version.load(), 0);
+
+  // Report k is about the k-th episode to end, which is the k-th episode in the shipped rows.
+  // (Reports the join socket would not queue are dropped and counted: ReachStop ends thousands
+  // of episodes a second, more than the fake learner reads.)
+  size_t checked = 0;
+  uint64_t last_episode = 0;
+  for (const ReportCopy& r : learner.reports) {
+    EXPECT_GT(r.episode, last_episode) << "reports arrive in order";
+    last_episode = r.episode;
+    if (r.episode > episodes.size()) {
+      break;
+    }
+    const auto [b, e] = episodes[r.episode - 1];
+    EXPECT_EQ(r.actor_id, 5U);
+    EXPECT_EQ(r.steps, e - b);
+    float sum = 0.0F;
+    for (size_t t = b; t < e; ++t) {
+      sum += rows.rewards[t];
+    }
+    EXPECT_NEAR(r.ret, sum, 1e-4);
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(r.policy_version, 0U);
+    ++checked;
+  }
+  EXPECT_GE(checked, 30U);
+  EXPECT_EQ(learner.reports.front().episode, 1U);
+  EXPECT_LE(static_cast<int64_t>(learner.reports.size()) + actor.counters.reports_dropped.load(),
+            actor.counters.episodes.load());
+
+  // Heartbeats carry the counters in the documented order.
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] {
+    return learner.last_heartbeat_counters.size() == 7 && learner.last_heartbeat_counters[0] > 0;  // env_steps
+  }));
+  EXPECT_GT(learner.last_heartbeat_counters[1], 0);                                        // episodes
+  EXPECT_GT(learner.last_heartbeat_counters[2], 0);                                        // batches_sent
+  EXPECT_EQ(learner.last_heartbeat_counters[3], 64 * learner.last_heartbeat_counters[2]);  // transitions_sent
+}
+
+TEST(ActorLoop, AppliesPublishedWeightsAndActsWithThem) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorLoopConfig config = test_loop_config();
+  config.exploration.epsilon_start = 0.0;  // greedy once weights arrive
+  config.exploration.epsilon_end = 0.0;
+  ActorRunner actor(ctx, learner.join_endpoint(), config);
+
+  const std::vector<float> out{0.5F, -0.5F, 0.25F};
+  ASSERT_TRUE(
+      publish_until_applied(learner, {&shard}, actor, weights_message(1, 100, 0, constant_output_params(out)), 1));
+  // Rows of episodes that began before the weights may still be in the next two batches.
+  const auto first_clean = static_cast<uint64_t>(actor.counters.batches_sent.load()) + 2;
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return shard.batches.size() >= first_clean + 3; }));
+  for (size_t i = first_clean; i < shard.batches.size(); ++i) {
+    const BatchCopy& b = shard.batches[i];
+    for (uint32_t r = 0; r < b.count; ++r) {
+      for (uint32_t k = 0; k < kWidth; ++k) {
+        ASSERT_EQ(b.actions[r * kWidth + k], out[k]) << "batch " << i << " row " << r;
+      }
+    }
+  }
+  ASSERT_TRUE(serve_until(learner, {&shard},
+                          [&] { return !learner.reports.empty() && learner.reports.back().policy_version == 1; }));
+
+  // bound = 2 (squashing): the actor squashes as the learner does; every range here is [-1, 1].
+  learner.publish(weights_message(2, 200, 2, constant_output_params(out)));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.weights_version.load() == 2; }));
+  const auto squashed_from = static_cast<uint64_t>(actor.counters.batches_sent.load()) + 2;
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return shard.batches.size() >= squashed_from + 2; }));
+  const BatchCopy& b = shard.batches.back();
+  for (uint32_t k = 0; k < kWidth; ++k) {
+    EXPECT_NEAR(b.actions[k], std::tanh(out[k]), 1e-6);
+  }
+}
+
+TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorRunner actor(ctx, learner.join_endpoint(), test_loop_config());
+  const std::vector<float> good = constant_output_params({0.1F, 0.2F, 0.3F});
+  ASSERT_TRUE(publish_until_applied(learner, {&shard}, actor, weights_message(1, 0, 0, good), 1));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return !shard.identity.empty(); }));
+  const int64_t before = actor.counters.malformed_messages.load();
+  EXPECT_EQ(before, 0);
+
+  // On the weights socket: five bad messages, then good weights. One PUB connection is FIFO, so
+  // once version 2 is applied all five have been looked at.
+  std::vector<float> nan_params = good;
+  nan_params[3] = std::numeric_limits<float>::quiet_NaN();
+  const std::array<int, 3> wrong_obs{5, 4, 3};
+  const Bytes garbage{'n', 'o', 't', ' ', 'a', ' ', 'f', 'l', 'a', 't', 'b', 'u', 'f', 'f', 'e', 'r'};
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_heartbeat(fbb, wire::Role::Learner, "learner", 1, {});
+  const Bytes heartbeat = copy_bytes(wire::bytes_of(fbb));
+  learner.publish(garbage);
+  learner.publish(heartbeat);  // verified, but not weights
+  learner.publish(weights_message(9, 0, 0, std::vector<float>(3 * 4 + 4 + 4 * 3 + 3), wrong_obs));
+  learner.publish(weights_message(9, 0, 0, std::vector<float>(7, 0.0F)));  // wrong parameter count
+  learner.publish(weights_message(9, 0, 0, nan_params));
+  learner.publish(weights_message(2, 0, 0, good));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.weights_version.load() == 2; }));
+  EXPECT_EQ(actor.counters.malformed_messages.load(), before + 5);
+
+  // On the join socket: garbage and a message type an actor never receives; on the shard's
+  // socket: anything at all.
+  learner.send_to_actor(garbage);
+  wire::build_sample_request(fbb, 1, 32);
+  learner.send_to_actor(wire::bytes_of(fbb));
+  shard.send_to_actor(garbage);
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.malformed_messages.load() == before + 8; }));
+
+  const int64_t steps = actor.counters.env_steps.load();
+  const size_t batches = shard.batches.size();
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] {
+    return actor.counters.env_steps.load() > steps + 1000 && shard.batches.size() > batches + 3;
+  }));
+  EXPECT_EQ(actor.counters.weights_version.load(), 2);
+  EXPECT_EQ(shard.invalid, 0);
+}
+
+TEST(ActorLoop, StartsRoundRobinAtActorIndexModShards) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard0(ctx);
+  FakeShard shard1(ctx);
+  learner.shard_endpoints = {shard0.endpoint(), shard1.endpoint()};
+  learner.actor_index = 3;
+  ActorRunner actor(ctx, learner.join_endpoint(), test_loop_config());
+  ASSERT_TRUE(serve_until(learner, {&shard0, &shard1},
+                          [&] { return shard0.batches.size() >= 5 && shard1.batches.size() >= 5; }));
+  for (const BatchCopy& b : shard1.batches) {
+    EXPECT_EQ(b.sequence % 2, 0U) << "3 % 2 = 1: shard 1 gets batches 0, 2, 4, ...";
+  }
+  for (const BatchCopy& b : shard0.batches) {
+    EXPECT_EQ(b.sequence % 2, 1U);
+  }
+}
+
+TEST(ActorLoop, RejoinsWhenTheLearnersMapIsNewer) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard a(ctx);
+  FakeShard b(ctx);
+  learner.shard_endpoints = {a.endpoint()};
+  ActorRunner actor(ctx, learner.join_endpoint(), test_loop_config());
+  ASSERT_TRUE(serve_until(learner, {&a, &b}, [&] { return a.batches.size() >= 2; }));
+  EXPECT_TRUE(b.batches.empty());
+
+  // A shard joins: the learner's heartbeat answers now say version 2.
+  learner.map_version = 2;
+  learner.shard_endpoints = {a.endpoint(), b.endpoint()};
+  ASSERT_TRUE(serve_until(learner, {&a, &b}, [&] { return b.batches.size() >= 2; }));
+  ASSERT_EQ(learner.joins.size(), 2U);
+  EXPECT_EQ(learner.joins[1].identity, learner.joins[0].identity) << "re-joins on the same socket";
+
+  // Shard a is dropped: the actor disconnects it and sends to b only.
+  learner.map_version = 3;
+  learner.shard_endpoints = {b.endpoint()};
+  ASSERT_TRUE(serve_until(learner, {&a, &b}, [&] { return learner.joins.size() == 3; }));
+  // Batches already on their way to a may still land; after that, none.
+  const size_t at_b = b.batches.size();
+  ASSERT_TRUE(serve_until(learner, {&a, &b}, [&] { return b.batches.size() >= at_b + 50; }));
+  const size_t at_a = a.batches.size();
+  ASSERT_TRUE(serve_until(learner, {&a, &b}, [&] { return b.batches.size() >= at_b + 100; }));
+  EXPECT_EQ(a.batches.size(), at_a);
+  for (const BatchCopy& batch : b.batches) {
+    EXPECT_EQ(batch.actor_id, 0U) << "the actor keeps its first index";
+  }
+}
+
+TEST(ActorLoop, BackpressureFromAFullShardHoldsTheEnvLoop) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx, /*recv_hwm=*/1);
+  shard.reading = false;
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorLoopConfig config = test_loop_config();
+  config.shard_send_hwm = 1;
+  ActorRunner actor(ctx, learner.join_endpoint(), config);
+
+  // Once the queues and the kernel buffers are full (blocked for a while), no step may happen.
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.send_blocked_ms.load() >= 500; }));
+  const int64_t steps = actor.counters.env_steps.load();
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.send_blocked_ms.load() >= 900; }));
+  EXPECT_EQ(actor.counters.env_steps.load(), steps) << "no steps while the only shard takes nothing";
+  EXPECT_GT(learner.heartbeats, 5) << "heartbeats go on while blocked";
+
+  shard.reading = true;
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.env_steps.load() > steps + 10000; }));
+  EXPECT_EQ(shard.invalid, 0);
+}
+
+TEST(ActorLoop, SkipsAShardThatIsGone) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard live(ctx);
+  std::string dead_endpoint;
+  {
+    FakeShard dead(ctx);  // bound, then closed: nothing listens there any more
+    dead_endpoint = dead.endpoint();
+  }
+  learner.shard_endpoints = {dead_endpoint, live.endpoint()};  // actor 0 starts with the dead one
+  ActorLoopConfig config = test_loop_config();
+  config.peer_timeout_ms = 300;
+  config.shard_send_hwm = 1;
+  ActorRunner actor(ctx, learner.join_endpoint(), config);
+  ASSERT_TRUE(serve_until(learner, {&live}, [&] { return live.batches.size() >= 10; }));
+  EXPECT_GE(actor.counters.send_blocked_ms.load(), 250);
+}
+
+TEST(ActorLoop, JoinRetriesOnAFreshSocketWhenTheLearnerDoesNotAnswer) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  learner.ignore_joins = 1;
+  ActorRunner actor(ctx, learner.join_endpoint(), test_loop_config(), 1, /*join_retry_ms=*/200);
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return !shard.batches.empty(); }));
+  ASSERT_EQ(learner.joins.size(), 2U);
+  EXPECT_NE(learner.joins[0].identity, learner.joins[1].identity);
+}
+
+TEST(LearnerLink, JoinGivesUpAfterItsTimeout) {
+  net::Context ctx;
+  std::string nobody;
+  {
+    FakeShard closed(ctx);
+    nobody = closed.endpoint();
+  }
+  LearnerLinkConfig c;
+  c.join_endpoint = nobody;
+  c.name = "test";
+  c.join_retry_ms = 100;
+  c.join_timeout_ms = 300;
+  LearnerLink link(ctx, c);
+  std::atomic<bool> stop{false};
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(link.join(stop).has_value());
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(s, 0.25);
+  EXPECT_LT(s, 1.5);
+  stop = true;
+  EXPECT_FALSE(link.join(stop).has_value()) << "returns at once when stopped";
+}
+
+TEST(ActorLoop, RejectsAnEmptyEnvListAndBadSettings) {
+  net::Context ctx;
+  ClusterInfo map;
+  map.weights_endpoint = "tcp://127.0.0.1:1";
+  ActorCounters counters;
+  const auto make = [&](ActorLoopConfig config, std::vector<std::unique_ptr<Env>> envs) {
+    LearnerLinkConfig lc;
+    lc.join_endpoint = "tcp://127.0.0.1:1";
+    ActorLoop loop(ctx, LearnerLink(ctx, lc), map, std::move(envs), std::move(config), counters);
+  };
+  EXPECT_THROW(make(test_loop_config(), {}), std::invalid_argument);
+  ActorLoopConfig bad = test_loop_config();
+  bad.batch_transitions = 0;
+  std::vector<std::unique_ptr<Env>> one;
+  one.push_back(std::make_unique<toy::ReachStopEnv>());
+  EXPECT_THROW(make(bad, std::move(one)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pamdp::testing

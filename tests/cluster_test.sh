@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Integration test of the distributed system on loopback: 1 learner, 2 replay shards and
+# 2 actors as real processes on the toy ReachStop task. Asserts that transitions flow, samples
+# are served, updates happen, weights reach the actors, episode reports are counted, and that
+# the checkpoint the learner wrote can be evaluated.
+# Usage: tests/cluster_test.sh PATH/TO/pamdp SOURCE_DIR
+set -euo pipefail
+bin=${1:?path to pamdp}
+src=${2:?source dir}
+work=$(mktemp -d /tmp/pamdp-cluster-test.XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  if [[ ${keep:-0} == 1 ]]; then echo "kept $work"; else rm -rf "$work"; fi
+}
+trap cleanup EXIT
+fail() {
+  echo "cluster_test: FAIL: $*" >&2
+  for f in "$work"/logs/*.log; do echo "--- $f"; tail -n 15 "$f"; done >&2
+  keep=1
+  exit 1
+}
+mkdir -p "$work/logs"
+
+# Ports are chosen by the OS (tcp://127.0.0.1:0) and read back from the learner's log.
+"$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
+  --set cluster.learner_bind=tcp://127.0.0.1:0 --set cluster.weights_bind=tcp://127.0.0.1:0 \
+  --set train.max_updates=12000 --set train.log_every_seconds=1 --set cluster.publish_every_updates=50 --set train.eval_every_updates=2000 \
+  --set replay.shards=2 ${CLUSTER_TEST_SETS:-} >"$work/logs/learner.log" 2>&1 &
+pids+=($!)
+join=""
+for _ in $(seq 100); do
+  join=$(grep -o 'join: *tcp://127.0.0.1:[0-9]*' "$work/logs/learner.log" | head -n1 | grep -o 'tcp://.*' || true)
+  [[ -n $join ]] && break
+  sleep 0.1
+done
+[[ -n $join ]] || fail "the learner did not report its join endpoint"
+
+for i in 0 1; do
+  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 \
+    >"$work/logs/shard-$i.log" 2>&1 &
+  pids+=($!)
+done
+for i in 0 1; do
+  "$bin" actor --join "$join" --seed $((10 + i)) >"$work/logs/actor-$i.log" 2>&1 &
+  pids+=($!)
+done
+
+# The learner stops by itself at train.max_updates; give it at most 90 s.
+for _ in $(seq 900); do
+  kill -0 "${pids[0]}" 2>/dev/null || break
+  sleep 0.1
+done
+if kill -0 "${pids[0]}" 2>/dev/null; then
+  fail "the learner did not reach 12000 updates within 90 s"
+fi
+wait "${pids[0]}" || fail "the learner exited with an error"
+
+metrics=$work/run/metrics.csv
+[[ -f $metrics ]] || fail "no metrics.csv"
+last=$(tail -n 1 "$metrics")
+IFS=, read -r _ updates episodes _ _ _ _ _ _ _ shards actors weights malformed _ <<<"$last"
+echo "learner: updates=$updates episodes=$episodes shards=$shards actors=$actors weights_version=$weights malformed=$malformed"
+((updates >= 12000)) || fail "updates $updates < 12000"
+((episodes > 0)) || fail "no episode reports reached the learner"
+((shards == 2)) || fail "expected 2 shards in the map, got $shards"
+((actors >= 2)) || fail "expected 2 actors to join, got $actors"
+((weights > 2)) || fail "weights were not published"
+grep -q "weights v[2-9]\|weights_version[ =:]*[2-9]\|version [2-9]" "$work"/logs/actor-*.log ||
+  echo "note: actor logs do not mention a weights version (format may differ)"
+
+# Every process was asked to stop; their closing lines carry their counters.
+for p in "${pids[@]:1}"; do kill -TERM "$p" 2>/dev/null || true; done
+wait 2>/dev/null || true
+for i in 0 1; do
+  line=$(grep "transitions inserted" "$work/logs/shard-$i.log" | tail -n 1)
+  inserted=$(sed -E 's/.* ([0-9]+) transitions inserted.*/\1/' <<<"$line")
+  sampled=$(sed -E 's/.* ([0-9]+) sampled.*/\1/' <<<"$line")
+  echo "shard $i: inserted=$inserted sampled=$sampled"
+  [[ $inserted =~ ^[0-9]+$ ]] && ((inserted > 0)) || fail "shard $i inserted no transitions"
+  [[ $sampled =~ ^[0-9]+$ ]] && ((sampled > 0)) || fail "shard $i served no samples"
+done
+for i in 0 1; do
+  line=$(grep "^done:" "$work/logs/actor-$i.log" | tail -n 1)
+  version=$(sed -E 's/.*weights v([0-9]+).*/\1/' <<<"$line")
+  echo "actor $i: $line"
+  [[ $version =~ ^[0-9]+$ ]] && ((version >= 2)) || fail "actor $i received no published weights"
+done
+
+# Learning through the network is reported, not asserted: on this tiny task the greedy policy
+# of a run this fast swings between 0 and 1 from one evaluation to the next (see the issue notes).
+best=$(awk -F, 'NR > 1 && $16 != "" { if ($16 > b) b = $16 } END { print b + 0 }' "$metrics")
+echo "best greedy evaluation during training: $best (random policy: about 0.1)"
+result=$("$bin" eval --checkpoint "$work/run/checkpoint.ckpt" --episodes 200 --json | tail -n 1)
+echo "greedy eval of the final checkpoint: $result"
+grep -q '"goal_rate"' <<<"$result" || fail "pamdp eval --checkpoint failed on the cluster's checkpoint"
+echo "cluster_test: OK"
