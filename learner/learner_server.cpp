@@ -155,13 +155,17 @@ void LearnerServer::handle_join_socket() {
         break;
       }
       case wire::Payload::Heartbeat: {
+        bool known = actor_index_.count(id) != 0;
         for (auto& s : shards_) {
           if (s->join_identity == id) {
             s->last_heard = Clock::now();
+            known = true;
           }
         }
+        // A peer this learner does not know (it restarted, or dropped the shard) is told map
+        // version 0, which never matches, so the peer joins again.
         const int64_t c[] = {counters_.updates, counters_.weights_version};
-        wire::build_heartbeat(fbb_->fbb, wire::Role::Learner, "learner", map_version_, c);
+        wire::build_heartbeat(fbb_->fbb, wire::Role::Learner, "learner", known ? map_version_ : 0, c);
         join_.send_to(identity.bytes(), wire::bytes_of(fbb_->fbb), 0);
         break;
       }

@@ -419,6 +419,7 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
     }
     shard_->insert(wire::rows_of(batch));
     inserted_.fetch_add(batch->count(), std::memory_order_relaxed);
+    size_.store(shard_->buffer().size(), std::memory_order_relaxed);
   }
 }
 
@@ -449,6 +450,7 @@ void ShardServer::read_sample_socket(Clock::time_point now) {
     slot.request_id = request->request_id();
     slot.batch_size = request->batch_size();
     ++waiting_count_;
+    waiting_now_.store(waiting_count_, std::memory_order_relaxed);
     serve_waiting_requests(now);
   }
 }
@@ -461,6 +463,12 @@ void ShardServer::serve_waiting_requests(Clock::time_point now) {
     }
     const wire::TransitionRows rows = shard_->sample(static_cast<int>(head.batch_size));
     wire::build_sample_reply(fbb_, head.request_id, rows);
+    // Counted before the send, so that whoever holds the reply sees the counters that include it
+    // (the slot stays untouched until the next push).
+    sampled_.fetch_add(head.batch_size, std::memory_order_relaxed);
+    waiting_head_ = (waiting_head_ + 1) % kMaxWaitingRequests;
+    --waiting_count_;
+    waiting_now_.store(waiting_count_, std::memory_order_relaxed);
     if (!sample_.send_to({head.identity.data(), head.identity_size}, wire::bytes_of(fbb_), 0)) {
       replies_dropped_.fetch_add(1, std::memory_order_relaxed);
       if (log_reply_.open(now)) {
@@ -468,9 +476,6 @@ void ShardServer::serve_waiting_requests(Clock::time_point now) {
                   options_.name, replies_dropped_.load(std::memory_order_relaxed));
       }
     }
-    sampled_.fetch_add(head.batch_size, std::memory_order_relaxed);
-    waiting_head_ = (waiting_head_ + 1) % kMaxWaitingRequests;
-    --waiting_count_;
   }
 }
 
