@@ -1,0 +1,155 @@
+// LearnerServer on loopback: the join handshake hands out the cluster map, malformed and
+// unexpected messages on every socket are dropped and counted while the server keeps working,
+// sample replies drive DDPG updates, and weights are published. Nothing sleeps: peers wait on
+// their sockets with bounded timeouts.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+#include <vector>
+
+#include "core/transport.hpp"
+#include "core/wire.hpp"
+#include "envs/toy/reach_stop.hpp"
+#include "learner/learner_server.hpp"
+
+namespace pamdp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr uint32_t kObs = 3;
+constexpr uint32_t kAct = 3;
+constexpr int kBatch = 4;
+
+DdpgConfig small() {
+  DdpgConfig c;
+  c.hidden = {8};
+  c.batch_size = kBatch;
+  return c;
+}
+
+struct Running {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  std::unique_ptr<LearnerServer> server;
+  std::thread thread;
+  std::atomic<bool> done{false};
+  Running() {
+    LearnerServerConfig c;
+    c.join_bind = "tcp://127.0.0.1:*";
+    c.weights_bind = "tcp://127.0.0.1:*";
+    c.config_toml = "[env]\nname = \"reach_stop\"\n";
+    c.publish_every_updates = 5;
+    c.max_updates = 20;
+    c.peer_timeout_ms = 60000;
+    server = std::make_unique<LearnerServer>(ctx, ddpg, c);
+    thread = std::thread([this] {
+      server->run();  // returns by itself after max_updates
+      done.store(true);
+    });
+  }
+  ~Running() {
+    server->stop();
+    thread.join();
+  }
+};
+
+// Receives one frame within timeout_ms or returns false.
+bool receive(net::Socket& s, net::Message& m, int timeout_ms) {
+  return s.recv(m, timeout_ms);
+}
+
+TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
+  Running run;
+  net::Context& ctx = run.ctx;
+  // A fake shard: a sample ROUTER the learner connects to, and a join DEALER.
+  net::Socket sample(ctx, net::SocketType::kRouter);
+  const std::string sample_endpoint = sample.bind("tcp://127.0.0.1:*");
+  net::Socket join(ctx, net::SocketType::kDealer);
+  join.connect(run.server->join_endpoint());
+  net::Socket weights(ctx, net::SocketType::kSub);
+  weights.subscribe_all();
+  weights.connect(run.server->weights_endpoint());
+
+  // Garbage first: raw bytes, a truncated envelope, an unexpected payload type.
+  const std::vector<uint8_t> junk{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  ASSERT_TRUE(join.send(junk, 1000));
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_sample_request(fbb, 1, 4);  // not something a learner's join socket accepts
+  ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
+  wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
+  const std::vector<uint8_t> truncated(wire::bytes_of(fbb).begin(), wire::bytes_of(fbb).begin() + 20);
+  ASSERT_TRUE(join.send(truncated, 1000));
+
+  // Then a real join: the answer is the cluster map with this shard in it.
+  ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
+  net::Message m;
+  const wire::ClusterMap* map = nullptr;
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (map == nullptr && Clock::now() < deadline) {
+    ASSERT_TRUE(receive(join, m, 5000));
+    const wire::Envelope* env = wire::open_envelope(m.bytes());
+    ASSERT_NE(env, nullptr);
+    map = env->payload_as_ClusterMap();
+  }
+  ASSERT_NE(map, nullptr);
+  ASSERT_EQ(map->shard_sample_endpoints()->size(), 1U);
+  EXPECT_EQ(map->shard_sample_endpoints()->Get(0)->str(), sample_endpoint);
+  EXPECT_NE(map->config_toml()->str().find("reach_stop"), std::string::npos);
+
+  // Serve sample requests: first one malformed reply (wrong widths), then good ones.
+  net::Message id;
+  net::Message req;
+  std::vector<float> states(kBatch * kObs, 0.1F);
+  std::vector<float> actions(kBatch * kAct, 0.2F);
+  std::vector<float> rewards(kBatch, 1.0F);
+  std::vector<uint8_t> terminals(kBatch, 1);
+  std::vector<float> returns(kBatch, 1.0F);
+  bool sent_bad = false;
+  int served = 0;
+  const auto until = Clock::now() + std::chrono::seconds(10);
+  while (!run.done.load() && Clock::now() < until) {
+    if (!sample.recv_from(id, req, 100)) {
+      continue;
+    }
+    const wire::Envelope* env = wire::open_envelope(req.bytes());
+    ASSERT_NE(env, nullptr);
+    const wire::SampleRequest* r = env->payload_as_SampleRequest();
+    ASSERT_NE(r, nullptr);
+    EXPECT_EQ(r->batch_size(), static_cast<uint32_t>(kBatch));
+    wire::TransitionRows rows{kBatch,         kObs,           kAct,          states.data(),
+                              actions.data(), rewards.data(), states.data(), terminals.data(),
+                              returns.data()};
+    if (!sent_bad) {
+      rows.obs_dim = kObs + 1;  // sizes that do not match the experiment
+      std::vector<float> wide(kBatch * (kObs + 1), 0.0F);
+      rows.states = rows.next_states = wide.data();
+      wire::build_sample_reply(fbb, r->request_id(), rows);
+      ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
+      sent_bad = true;
+      continue;
+    }
+    wire::build_sample_reply(fbb, r->request_id(), rows);
+    ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
+    ++served;
+  }
+  ASSERT_TRUE(run.done.load()) << "the learner did not reach max_updates";
+  EXPECT_GE(run.ddpg.updates(), 20);
+  EXPECT_GE(served, 20);
+
+  // Weights were published (at start and every 5 updates) and carry the actor's layout.
+  ASSERT_TRUE(receive(weights, m, 5000));
+  const wire::Envelope* env = wire::open_envelope(m.bytes());
+  ASSERT_NE(env, nullptr);
+  const wire::PolicyWeights* w = env->payload_as_PolicyWeights();
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->params()->size(), static_cast<uint32_t>(run.ddpg.actor().num_params()));
+  EXPECT_GE(run.server->counters().weights_version, 2);
+  // junk, wrong type, truncated, wrong-width reply.
+  EXPECT_EQ(run.server->counters().malformed_messages, 4);
+}
+
+}  // namespace
+}  // namespace pamdp
