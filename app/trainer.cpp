@@ -233,6 +233,7 @@ void Trainer::log_tick(bool force) {
     metrics_ << ",,";
   }
   metrics_ << '\n' << std::flush;
+  episodes_csv_ << std::flush;  // so a killed run keeps its episode log up to the last tick
   if (!o_.quiet) {
     std::printf(
         "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | eps %.3f | loss %.4g | Q %.3f "
