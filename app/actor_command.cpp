@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,7 @@ struct ActorCliOptions {
   int64_t seed = -1;
   bool apex_epsilon = false;
   std::string name;
+  std::string curve_keys;
   double join_timeout_s = 0.0;
   double progress_every_s = 5.0;
 };
@@ -55,6 +57,11 @@ void run_actor(const ActorCliOptions& o) {
   link_config.name = o.name.empty() ? default_name() : o.name;
   link_config.actor_envs = static_cast<uint32_t>(o.envs);
   link_config.join_timeout_ms = static_cast<int>(o.join_timeout_s * 1000.0);
+  std::optional<net::CurveClientKeys> curve;
+  if (!o.curve_keys.empty()) {
+    curve = net::load_curve_keyring(o.curve_keys, /*need_server=*/false).client;
+    link_config.curve = curve;
+  }
   LearnerLink link(ctx, link_config);
   const std::optional<ClusterInfo> map = link.join(g_stop);
   if (!map) {
@@ -80,10 +87,7 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.peer_timeout_ms = config.cluster.peer_timeout_ms;
   loop_config.apex_epsilon = o.apex_epsilon;
   loop_config.seed = o.seed >= 0 ? static_cast<uint64_t>(o.seed) : config.seed;
-  if (config.cluster.curve) {
-    throw std::runtime_error(
-        "cluster.curve = true, but pamdp actor has no CURVE client keys option yet; run the cluster without CURVE");
-  }
+  loop_config.curve = curve;
 
   ActorCounters counters;
   ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);
@@ -134,6 +138,9 @@ void register_actor(CLI::App& app) {
   cmd->add_flag("--apex-epsilon", o->apex_epsilon,
                 "per-actor fixed epsilon 0.4^(1 + 7 i / (N - 1)) (Ape-X) instead of the learner's schedule");
   cmd->add_option("--name", o->name, "name in the learner's logs (default HOST:PID)");
+  cmd->add_option("--curve-keys", o->curve_keys,
+                  "directory with client.keys from pamdp keygen: CURVE on every connection (the learner must run "
+                  "with cluster.curve = true)");
   cmd->add_option("--join-timeout", o->join_timeout_s, "give up joining after this many seconds (0: keep trying)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

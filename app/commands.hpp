@@ -13,5 +13,6 @@ void register_sim(CLI::App& app);
 void register_train(CLI::App& app);
 void register_replay(CLI::App& app);
 void register_learner(CLI::App& app);
+void register_keygen(CLI::App& app);
 
 }  // namespace pamdp::app

@@ -74,9 +74,6 @@ void run_learner(const LearnerCliOptions& o) {
       throw std::runtime_error("run directory '" + run_dir + "' already holds a run; use --resume " + run_dir);
     }
   }
-  if (c.cluster.curve) {
-    throw std::runtime_error("cluster.curve = true: CURVE keys are not supported by this build yet; set it to false");
-  }
   fs::create_directories(run_dir);
   const std::string config_text = to_toml(c);
   if (!resume) {
@@ -106,6 +103,13 @@ void run_learner(const LearnerCliOptions& o) {
   sc.max_seconds = c.train.max_seconds;
 
   net::Context ctx;
+  std::unique_ptr<net::CurveAuthenticator> auth;  // before the server: outlives its sockets
+  if (c.cluster.curve) {
+    const net::CurveKeyring keys = net::load_curve_keyring(c.cluster.curve_keys_dir, /*need_server=*/true);
+    sc.curve = keys.server;
+    sc.curve_client = keys.client;
+    auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
+  }
   LearnerServer server(ctx, ddpg, sc);
   g_server = &server;
   std::signal(SIGINT, on_learner_signal);

@@ -26,6 +26,7 @@ int run(int argc, char** argv) {
   pamdp::app::register_train(app);
   pamdp::app::register_replay(app);
   pamdp::app::register_learner(app);
+  pamdp::app::register_keygen(app);
 
   std::string valid;
   bool known = false;

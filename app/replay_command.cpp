@@ -37,6 +37,7 @@ struct ReplayCliOptions {
   std::string advertise_host = "127.0.0.1";
   std::string snapshot;
   std::string name;
+  std::string curve_keys;
 };
 
 std::string default_name() {
@@ -57,6 +58,13 @@ void run_replay(const ReplayCliOptions& o) {
   options.name = o.name.empty() ? default_name() : o.name;
 
   net::Context ctx;
+  std::unique_ptr<net::CurveAuthenticator> auth;
+  if (!o.curve_keys.empty()) {
+    const net::CurveKeyring keys = net::load_curve_keyring(o.curve_keys, /*need_server=*/true);
+    options.curve_server = keys.server;
+    options.curve_client = keys.client;
+    auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
+  }
   ShardServer server(ctx, options, shard_config_from_toml);
   std::printf("pamdp replay: inserts at %s, samples at %s; joining the learner at %s\n",
               server.insert_endpoint().c_str(), server.sample_endpoint().c_str(), o.join.c_str());
@@ -85,9 +93,6 @@ void run_replay(const ReplayCliOptions& o) {
 }  // namespace
 
 ShardConfig shard_config_from_experiment(const ExperimentConfig& config) {
-  if (config.cluster.curve) {
-    throw std::runtime_error("cluster.curve = true: CURVE keys are not supported by pamdp replay yet; set it to false");
-  }
   const int64_t shards = config.replay.shards;
   ShardConfig s;
   s.capacity = config.replay.capacity / shards;
@@ -132,6 +137,9 @@ void register_replay(CLI::App& app) {
   cmd->add_option("--snapshot", o->snapshot,
                   "replay snapshot file: loaded when the shard starts (if present), written when it stops");
   cmd->add_option("--name", o->name, "name in the learner's logs (default replay@HOST:PID)");
+  cmd->add_option("--curve-keys", o->curve_keys,
+                  "directory written by pamdp keygen: encrypt and authenticate every socket with CURVE "
+                  "(the learner must run with cluster.curve = true)");
   // Lets the global --log-level come after the subcommand name too.
   cmd->fallthrough();
   cmd->callback([o] { run_replay(*o); });

@@ -14,7 +14,7 @@ namespace pamdp::app {
 // constructed once to ask); samples per insert = cluster.samples_per_insert, or
 // train.updates_per_step * ddpg.batch_size when that is 0; min_size = replay.warmup /
 // replay.shards; slack = cluster.rate_limit_slack. Throws std::runtime_error naming the key if
-// the config cannot describe a shard (capacity below one transition per shard, CURVE asked for).
+// the config cannot describe a shard (capacity below one transition per shard).
 ShardConfig shard_config_from_experiment(const ExperimentConfig& config);
 // Parses a ClusterMap's config_toml and maps it: the ShardServer's ShardConfigFromMap.
 ShardConfig shard_config_from_toml(const std::string& config_toml);

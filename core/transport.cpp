@@ -1,11 +1,20 @@
 #include "core/transport.hpp"
 
+#include <sys/stat.h>
 #include <zmq.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 #include <zmq.hpp>
+
+#include "core/log.hpp"
 
 namespace pamdp::net {
 namespace {
@@ -303,6 +312,155 @@ CurveServerKeys generate_curve_keypair() {
                              " (libzmq built without CURVE support?)");
   }
   return {pub, sec};
+}
+
+namespace {
+
+void write_secret_file(const std::string& path, const std::string& text) {
+  if (std::filesystem::exists(path)) {
+    throw std::runtime_error("'" + path + "' exists; keys are never overwritten (remove it or choose another --dir)");
+  }
+  std::ofstream out(path);
+  if (!out) {
+    throw std::runtime_error("cannot write '" + path + "'");
+  }
+  out << text;
+  out.close();
+  ::chmod(path.c_str(), 0600);
+}
+
+std::map<std::string, std::string> read_key_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error("cannot read CURVE key file '" + path +
+                             "' (create the keys with: pamdp keygen --dir DIR)");
+  }
+  std::map<std::string, std::string> kv;
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto eq = line.find('=');
+    if (line.empty() || line[0] == '#' || eq == std::string::npos) {
+      continue;
+    }
+    auto trim = [](std::string v) {
+      const auto a = v.find_first_not_of(" \t\"");
+      const auto b = v.find_last_not_of(" \t\"\r");
+      return a == std::string::npos ? std::string() : v.substr(a, b - a + 1);
+    };
+    kv[trim(line.substr(0, eq))] = trim(line.substr(eq + 1));
+  }
+  return kv;
+}
+
+std::string key(const std::map<std::string, std::string>& kv, const std::string& name, const std::string& path) {
+  const auto it = kv.find(name);
+  if (it == kv.end() || it->second.size() != 40) {
+    throw std::runtime_error("CURVE key file '" + path + "' lacks a 40-character Z85 '" + name + "'");
+  }
+  return it->second;
+}
+
+}  // namespace
+
+void write_curve_keyring(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const CurveServerKeys server = generate_curve_keypair();
+  const CurveServerKeys client = generate_curve_keypair();
+  write_secret_file(dir + "/server.keys",
+                    "# pamdp CURVE keys of the bound sockets (learner, replay shards)\npublic = \"" +
+                        server.public_key + "\"\nsecret = \"" + server.secret_key + "\"\n");
+  write_secret_file(dir + "/client.keys", "# pamdp CURVE keys of the connecting sockets (every process)\npublic = \"" +
+                                              client.public_key + "\"\nsecret = \"" + client.secret_key +
+                                              "\"\nserver_public = \"" + server.public_key + "\"\n");
+}
+
+CurveKeyring load_curve_keyring(const std::string& dir, bool need_server) {
+  CurveKeyring k;
+  const std::string cpath = dir + "/client.keys";
+  const auto c = read_key_file(cpath);
+  k.client = {key(c, "public", cpath), key(c, "secret", cpath), key(c, "server_public", cpath)};
+  const std::string spath = dir + "/server.keys";
+  if (need_server || std::filesystem::exists(spath)) {
+    const auto s = read_key_file(spath);
+    k.server = {key(s, "public", spath), key(s, "secret", spath)};
+    if (k.server.public_key != k.client.server_public_key) {
+      throw std::runtime_error("'" + spath + "' and '" + cpath + "' are not from the same pamdp keygen run");
+    }
+  }
+  return k;
+}
+
+struct CurveAuthenticator::Impl {
+  void* rep = nullptr;
+  std::thread thread;
+  std::atomic<bool> stop{false};
+  std::atomic<int64_t> accepted{0};
+  std::atomic<int64_t> refused{0};
+  std::vector<std::string> allowed;  // 32-byte binary public keys
+};
+
+CurveAuthenticator::CurveAuthenticator(Context& ctx, const std::vector<std::string>& allowed_client_keys)
+    : impl_(std::make_unique<Impl>()) {
+  for (const std::string& z85 : allowed_client_keys) {
+    uint8_t bin[32];
+    if (z85.size() != 40 || zmq_z85_decode(bin, z85.c_str()) == nullptr) {
+      throw std::runtime_error("CURVE client key '" + z85 + "' is not 40 characters of Z85");
+    }
+    impl_->allowed.emplace_back(reinterpret_cast<const char*>(bin), 32);
+  }
+  impl_->rep = zmq_socket(ctx.raw(), ZMQ_REP);
+  if (impl_->rep == nullptr || zmq_bind(impl_->rep, "inproc://zeromq.zap.01") != 0) {
+    throw std::runtime_error(std::string("cannot start the CURVE authenticator: ") + zmq_strerror(zmq_errno()));
+  }
+  impl_->thread = std::thread([impl = impl_.get()] {
+    while (!impl->stop.load()) {
+      zmq_pollitem_t item{impl->rep, 0, ZMQ_POLLIN, 0};
+      if (zmq_poll(&item, 1, 100) <= 0) {
+        continue;
+      }
+      // ZAP request (RFC 27): version, request id, domain, address, identity, mechanism, credentials.
+      std::vector<std::string> frames;
+      int more = 1;
+      while (more != 0) {
+        zmq_msg_t m;
+        zmq_msg_init(&m);
+        if (zmq_msg_recv(&m, impl->rep, 0) < 0) {
+          zmq_msg_close(&m);
+          break;
+        }
+        frames.emplace_back(static_cast<const char*>(zmq_msg_data(&m)), zmq_msg_size(&m));
+        more = zmq_msg_more(&m);
+        zmq_msg_close(&m);
+      }
+      const bool ok = frames.size() >= 7 && frames[5] == "CURVE" &&
+                      std::find(impl->allowed.begin(), impl->allowed.end(), frames[6]) != impl->allowed.end();
+      const std::string request_id = frames.size() > 1 ? frames[1] : std::string();
+      if (ok) {
+        impl->accepted.fetch_add(1);
+      } else {
+        const int64_t n = impl->refused.fetch_add(1) + 1;
+        pamdp::log::warn("CURVE: refused a connection from {} without an allowed client key ({} refused so far)",
+                         frames.size() > 3 ? frames[3] : std::string("?"), n);
+      }
+      const std::string reply[] = {"1.0", request_id, ok ? "200" : "400", ok ? "OK" : "client key not allowed", "", ""};
+      for (size_t i = 0; i < 6; ++i) {
+        zmq_send(impl->rep, reply[i].data(), reply[i].size(), i + 1 < 6 ? ZMQ_SNDMORE : 0);
+      }
+    }
+  });
+}
+
+CurveAuthenticator::~CurveAuthenticator() {
+  impl_->stop.store(true);
+  impl_->thread.join();
+  zmq_close(impl_->rep);
+}
+
+int64_t CurveAuthenticator::accepted() const {
+  return impl_->accepted.load();
+}
+int64_t CurveAuthenticator::refused() const {
+  return impl_->refused.load();
 }
 
 }  // namespace pamdp::net

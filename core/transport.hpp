@@ -133,4 +133,35 @@ class Poller {
 // Generates a CURVE key pair (Z85). Throws if libzmq was built without CURVE.
 CurveServerKeys generate_curve_keypair();
 
+// The keys of one cluster (pamdp keygen): the servers' pair (every bound socket) and the
+// clients' pair (every connecting socket, with the servers' public key). Files in `dir`:
+// server.keys (public + secret) and client.keys (public + secret + server_public), mode 0600.
+struct CurveKeyring {
+  CurveServerKeys server;
+  CurveClientKeys client;
+};
+// Writes a fresh keyring; refuses to overwrite existing files.
+void write_curve_keyring(const std::string& dir);
+// Reads a keyring; throws std::runtime_error naming the file and what is wrong. Actors need
+// only client.keys: with need_server = false a missing server.keys is not an error.
+CurveKeyring load_curve_keyring(const std::string& dir, bool need_server);
+
+// ZeroMQ authentication (ZAP) for every CURVE server socket of a Context: a connection is
+// accepted only if the client's public key is one of `allowed_client_keys` (Z85); others are
+// refused during the handshake (no message of theirs is ever delivered) and counted and logged.
+// Runs a thread; construct it before binding, destroy it after the sockets.
+class CurveAuthenticator {
+ public:
+  CurveAuthenticator(Context& ctx, const std::vector<std::string>& allowed_client_keys);
+  ~CurveAuthenticator();
+  CurveAuthenticator(const CurveAuthenticator&) = delete;
+  CurveAuthenticator& operator=(const CurveAuthenticator&) = delete;
+  [[nodiscard]] int64_t accepted() const;
+  [[nodiscard]] int64_t refused() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace pamdp::net

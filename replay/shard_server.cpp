@@ -185,6 +185,13 @@ ShardServer::ShardServer(net::Context& ctx, ShardServerOptions options, ShardCon
   sample_.set_router_mandatory(true);  // a reply to a vanished learner fails visibly (counted)
   join_.set_max_message_bytes(kMaxJoinReplyBytes);
   join_.set_send_hwm(kJoinSendHwm);
+  if (options_.curve_server) {
+    insert_.make_curve_server(*options_.curve_server);
+    sample_.make_curve_server(*options_.curve_server);
+  }
+  if (options_.curve_client) {
+    join_.make_curve_client(*options_.curve_client);
+  }
   insert_endpoint_ = advertised(insert_.bind(options_.insert_bind), options_.advertise_host);
   sample_endpoint_ = advertised(sample_.bind(options_.sample_bind), options_.advertise_host);
   join_.connect(options_.join_endpoint);

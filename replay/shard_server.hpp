@@ -115,6 +115,10 @@ struct ShardServerOptions {
   // Frames above this size make ZeroMQ drop the sender's connection before anything reads them.
   // Fixed at bind time, before the widths are known (a 4096-row HFO batch is 2.1 MB).
   int64_t max_insert_message_bytes = int64_t{8} << 20;
+  // CURVE (pamdp keygen): server keys for the two bound sockets, client keys for the join
+  // connection. Both or neither; the caller runs a net::CurveAuthenticator on the context.
+  std::optional<net::CurveServerKeys> curve_server;
+  std::optional<net::CurveClientKeys> curve_client;
 };
 
 // Counters, readable from any thread (each field is read atomically, not all together).

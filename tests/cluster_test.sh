@@ -3,10 +3,13 @@
 # 2 actors as real processes on the toy ReachStop task. Asserts that transitions flow, samples
 # are served, updates happen, weights reach the actors, episode reports are counted, and that
 # the checkpoint the learner wrote can be evaluated.
-# Usage: tests/cluster_test.sh PATH/TO/pamdp SOURCE_DIR
+# With a third argument "curve", every socket uses CURVE (pamdp keygen), and an actor with keys
+# of another keygen run must be refused by the learner without disturbing the cluster.
+# Usage: tests/cluster_test.sh PATH/TO/pamdp SOURCE_DIR [curve]
 set -euo pipefail
 bin=${1:?path to pamdp}
 src=${2:?source dir}
+mode=${3:-plain}
 work=$(mktemp -d /tmp/pamdp-cluster-test.XXXXXX)
 pids=()
 cleanup() {
@@ -22,12 +25,28 @@ fail() {
   exit 1
 }
 mkdir -p "$work/logs"
+learner_curve=()
+peer_curve=()
+if [[ $mode == curve ]]; then
+  "$bin" keygen --dir "$work/keys" >/dev/null
+  "$bin" keygen --dir "$work/wrong-keys" >/dev/null
+  # The intruder knows the cluster's public server key (it is public) but not an allowed client key.
+  # (Z85 keys contain characters sed treats specially, so the file is rewritten with printf.)
+  server_public=$(grep '^public' "$work/keys/server.keys" | cut -d'"' -f2)
+  own_public=$(grep '^public' "$work/wrong-keys/client.keys" | cut -d'"' -f2)
+  own_secret=$(grep '^secret' "$work/wrong-keys/client.keys" | cut -d'"' -f2)
+  printf 'public = "%s"\nsecret = "%s"\nserver_public = "%s"\n' "$own_public" "$own_secret" "$server_public" \
+    >"$work/wrong-keys/client.keys"
+  rm "$work/wrong-keys/server.keys"
+  learner_curve=(--set cluster.curve=true --set "cluster.curve_keys_dir=$work/keys")
+  peer_curve=(--curve-keys "$work/keys")
+fi
 
 # Ports are chosen by the OS (tcp://127.0.0.1:0) and read back from the learner's log.
 "$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
   --set cluster.learner_bind=tcp://127.0.0.1:0 --set cluster.weights_bind=tcp://127.0.0.1:0 \
   --set train.max_updates=12000 --set train.log_every_seconds=1 --set cluster.publish_every_updates=50 --set train.eval_every_updates=2000 \
-  --set replay.shards=2 ${CLUSTER_TEST_SETS:-} >"$work/logs/learner.log" 2>&1 &
+  --set replay.shards=2 "${learner_curve[@]}" ${CLUSTER_TEST_SETS:-} >"$work/logs/learner.log" 2>&1 &
 pids+=($!)
 join=""
 for _ in $(seq 100); do
@@ -38,14 +57,19 @@ done
 [[ -n $join ]] || fail "the learner did not report its join endpoint"
 
 for i in 0 1; do
-  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 \
+  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 "${peer_curve[@]}" \
     >"$work/logs/shard-$i.log" 2>&1 &
   pids+=($!)
 done
 for i in 0 1; do
-  "$bin" actor --join "$join" --seed $((10 + i)) >"$work/logs/actor-$i.log" 2>&1 &
+  "$bin" actor --join "$join" --seed $((10 + i)) "${peer_curve[@]}" >"$work/logs/actor-$i.log" 2>&1 &
   pids+=($!)
 done
+if [[ $mode == curve ]]; then
+  # An intruder with another keygen run's keys: refused at the handshake, never joins.
+  "$bin" actor --join "$join" --curve-keys "$work/wrong-keys" >"$work/logs/intruder.log" 2>&1 &
+  pids+=($!)
+fi
 
 # The learner stops by itself at train.max_updates; give it at most 90 s.
 for _ in $(seq 900); do
@@ -66,6 +90,11 @@ echo "learner: updates=$updates episodes=$episodes shards=$shards actors=$actors
 ((episodes > 0)) || fail "no episode reports reached the learner"
 ((shards == 2)) || fail "expected 2 shards in the map, got $shards"
 ((actors >= 2)) || fail "expected 2 actors to join, got $actors"
+if [[ $mode == curve ]]; then
+  ((actors == 2)) || fail "the actor with the wrong keys joined ($actors actors)"
+  grep -q "CURVE: refused" "$work/logs/learner.log" || fail "the learner did not log refusing the wrong keys"
+  echo "CURVE: the intruder was refused: $(grep -c 'CURVE: refused' "$work/logs/learner.log") refusals logged"
+fi
 ((weights > 2)) || fail "weights were not published"
 grep -q "weights v[2-9]\|weights_version[ =:]*[2-9]\|version [2-9]" "$work"/logs/actor-*.log ||
   echo "note: actor logs do not mention a weights version (format may differ)"
@@ -82,7 +111,7 @@ for i in 0 1; do
   [[ $sampled =~ ^[0-9]+$ ]] && ((sampled > 0)) || fail "shard $i served no samples"
 done
 for i in 0 1; do
-  line=$(grep "^done:" "$work/logs/actor-$i.log" | tail -n 1)
+  line=$(grep "^done:" "$work/logs/actor-$i.log" | tail -n 1 || true)
   version=$(sed -E 's/.*weights v([0-9]+).*/\1/' <<<"$line")
   echo "actor $i: $line"
   [[ $version =~ ^[0-9]+$ ]] && ((version >= 2)) || fail "actor $i received no published weights"
