@@ -5,16 +5,28 @@
 # the checkpoint the learner wrote can be evaluated.
 # With a third argument "curve", every socket uses CURVE (pamdp keygen), and an actor with keys
 # of another keygen run must be refused by the learner without disturbing the cluster.
-# Usage: tests/cluster_test.sh PATH/TO/pamdp SOURCE_DIR [curve]
+# With "netns", the same with CURVE across two network namespaces made for the test (learner and
+# shards in one, actors in the other, joined by a veth pair); it needs root and `ip netns` and
+# exits 77 (ctest: skipped) with a message where that is not permitted.
+# Usage: tests/cluster_test.sh PATH/TO/pamdp SOURCE_DIR [curve|netns]
 set -euo pipefail
 bin=${1:?path to pamdp}
 src=${2:?source dir}
 mode=${3:-plain}
 work=$(mktemp -d /tmp/pamdp-cluster-test.XXXXXX)
 pids=()
+host=127.0.0.1
+srv=()  # command prefix of the learner's side
+act=()  # command prefix of the actors' side
+ns_srv="pamdp-srv-$$"
+ns_act="pamdp-act-$$"
 cleanup() {
   for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
+  if [[ $mode == netns ]]; then
+    ip netns del "$ns_srv" 2>/dev/null || true
+    ip netns del "$ns_act" 2>/dev/null || true
+  fi
   if [[ ${keep:-0} == 1 ]]; then echo "kept $work"; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
@@ -25,9 +37,30 @@ fail() {
   exit 1
 }
 mkdir -p "$work/logs"
+if [[ $mode == netns ]]; then
+  if [[ $(id -u) -ne 0 ]] || ! command -v ip >/dev/null || ! ip netns add "$ns_srv" 2>/dev/null; then
+    echo "cluster_test netns: SKIPPED: needs root and 'ip netns' (iproute2) to make test namespaces"
+    exit 77
+  fi
+  # Two test hosts of our own: 10.77.0.1 (learner, shards) and 10.77.0.2 (actors).
+  ip netns add "$ns_act"
+  ip link add "veth-s$$" type veth peer name "veth-a$$"
+  ip link set "veth-s$$" netns "$ns_srv"
+  ip link set "veth-a$$" netns "$ns_act"
+  ip -n "$ns_srv" addr add 10.77.0.1/30 dev "veth-s$$"
+  ip -n "$ns_act" addr add 10.77.0.2/30 dev "veth-a$$"
+  for ns in "$ns_srv" "$ns_act"; do
+    ip -n "$ns" link set lo up
+  done
+  ip -n "$ns_srv" link set "veth-s$$" up
+  ip -n "$ns_act" link set "veth-a$$" up
+  host=10.77.0.1
+  srv=(ip netns exec "$ns_srv")
+  act=(ip netns exec "$ns_act")
+fi
 learner_curve=()
 peer_curve=()
-if [[ $mode == curve ]]; then
+if [[ $mode == curve || $mode == netns ]]; then
   "$bin" keygen --dir "$work/keys" >/dev/null
   "$bin" keygen --dir "$work/wrong-keys" >/dev/null
   # The intruder knows the cluster's public server key (it is public) but not an allowed client key.
@@ -43,31 +76,32 @@ if [[ $mode == curve ]]; then
 fi
 
 # Ports are chosen by the OS (tcp://127.0.0.1:0) and read back from the learner's log.
-"$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
-  --set cluster.learner_bind=tcp://127.0.0.1:0 --set cluster.weights_bind=tcp://127.0.0.1:0 \
+"${srv[@]}" "$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
+  --set "cluster.learner_bind=tcp://$host:0" --set "cluster.weights_bind=tcp://$host:0" --set "cluster.advertise_host=$host" \
   --set train.max_updates=12000 --set train.log_every_seconds=1 --set cluster.publish_every_updates=50 --set train.eval_every_updates=2000 \
   --set replay.shards=2 "${learner_curve[@]}" ${CLUSTER_TEST_SETS:-} >"$work/logs/learner.log" 2>&1 &
 pids+=($!)
 join=""
 for _ in $(seq 100); do
-  join=$(grep -o 'join: *tcp://127.0.0.1:[0-9]*' "$work/logs/learner.log" | head -n1 | grep -o 'tcp://.*' || true)
+  join=$(grep -o "join: *tcp://$host:[0-9]*" "$work/logs/learner.log" | head -n1 | grep -o 'tcp://.*' || true)
   [[ -n $join ]] && break
   sleep 0.1
 done
 [[ -n $join ]] || fail "the learner did not report its join endpoint"
 
 for i in 0 1; do
-  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 "${peer_curve[@]}" \
+  "${srv[@]}" "$bin" replay --join "$join" --insert-bind "tcp://$host:0" --sample-bind "tcp://$host:0" \
+    --advertise-host "$host" "${peer_curve[@]}" \
     >"$work/logs/shard-$i.log" 2>&1 &
   pids+=($!)
 done
 for i in 0 1; do
-  "$bin" actor --join "$join" --seed $((10 + i)) "${peer_curve[@]}" >"$work/logs/actor-$i.log" 2>&1 &
+  "${act[@]}" "$bin" actor --join "$join" --seed $((10 + i)) "${peer_curve[@]}" >"$work/logs/actor-$i.log" 2>&1 &
   pids+=($!)
 done
-if [[ $mode == curve ]]; then
+if [[ $mode == curve || $mode == netns ]]; then
   # An intruder with another keygen run's keys: refused at the handshake, never joins.
-  "$bin" actor --join "$join" --curve-keys "$work/wrong-keys" >"$work/logs/intruder.log" 2>&1 &
+  "${act[@]}" "$bin" actor --join "$join" --curve-keys "$work/wrong-keys" >"$work/logs/intruder.log" 2>&1 &
   pids+=($!)
 fi
 
@@ -90,7 +124,7 @@ echo "learner: updates=$updates episodes=$episodes shards=$shards actors=$actors
 ((episodes > 0)) || fail "no episode reports reached the learner"
 ((shards == 2)) || fail "expected 2 shards in the map, got $shards"
 ((actors >= 2)) || fail "expected 2 actors to join, got $actors"
-if [[ $mode == curve ]]; then
+if [[ $mode == curve || $mode == netns ]]; then
   ((actors == 2)) || fail "the actor with the wrong keys joined ($actors actors)"
   grep -q "CURVE: refused" "$work/logs/learner.log" || fail "the learner did not log refusing the wrong keys"
   echo "CURVE: the intruder was refused: $(grep -c 'CURVE: refused' "$work/logs/learner.log") refusals logged"
