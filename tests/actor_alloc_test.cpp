@@ -10,86 +10,7 @@
 #include <new>
 
 #include "actor_harness.hpp"
-
-namespace {
-
-thread_local bool t_counting = false;
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t size, std::size_t align) {
-  if (t_counting) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (size == 0) {
-    size = 1;
-  }
-  void* p = align <= alignof(std::max_align_t) ? std::malloc(size)
-                                               : std::aligned_alloc(align, (size + align - 1) / align * align);
-  if (p == nullptr) {
-    throw std::bad_alloc();
-  }
-  return p;
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void* operator new[](std::size_t size) {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void* operator new(std::size_t size, std::align_val_t align) {
-  return counted_alloc(size, static_cast<std::size_t>(align));
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  return counted_alloc(size, static_cast<std::size_t>(align));
-}
-// libzmq allocates with new (std::nothrow); these must match the deletes below too.
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted_alloc(size, alignof(std::max_align_t));
-  } catch (const std::bad_alloc&) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted_alloc(size, alignof(std::max_align_t));
-  } catch (const std::bad_alloc&) {
-    return nullptr;
-  }
-}
-void operator delete(void* p, const std::nothrow_t&) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, const std::nothrow_t&) noexcept {
-  std::free(p);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
-  std::free(p);
-}
+#include "counting_new.hpp"
 
 namespace pamdp::testing {
 namespace {
@@ -117,11 +38,11 @@ TEST(ActorLoopAllocations, SteadyStateActingAllocatesNothing) {
       steps0 = c.env_steps.load();
       batches0 = c.batches_sent.load();
       episodes0 = c.episodes.load();
-      g_allocations = 0;
-      t_counting = true;
+      alloc::count_this_thread(true);
+      alloc::start_counting(/*only_marked_threads=*/true);
       phase = 1;
     } else if (phase.load() == 1 && ++ticks >= kTicks) {
-      t_counting = false;
+      alloc::stop_counting();
       steps_counted = c.env_steps.load() - steps0;
       batches_counted = c.batches_sent.load() - batches0;
       episodes_counted = c.episodes.load() - episodes0;
@@ -143,7 +64,7 @@ TEST(ActorLoopAllocations, SteadyStateActingAllocatesNothing) {
   EXPECT_GT(steps_counted.load(), 1000);
   EXPECT_GT(batches_counted.load(), 10);
   EXPECT_GT(episodes_counted.load(), 10);
-  EXPECT_EQ(g_allocations.load(), 0) << "over " << steps_counted.load() << " env steps";
+  EXPECT_EQ(alloc::allocations(), 0) << "over " << steps_counted.load() << " env steps";
 }
 
 }  // namespace

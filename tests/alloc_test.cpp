@@ -10,93 +10,12 @@
 #include <vector>
 
 #include "core/policy.hpp"
+#include "counting_new.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/toy/reach_stop.hpp"
 
-namespace {
-
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t size, std::size_t align) {
-  if (g_counting.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (size == 0) {
-    size = 1;
-  }
-  if (align <= alignof(std::max_align_t)) {
-    return std::malloc(size);
-  }
-  return std::aligned_alloc(align, (size + align - 1) / align * align);
-}
-
-void* alloc_or_throw(std::size_t size, std::size_t align) {
-  void* p = counted_alloc(size, align);
-  if (p == nullptr) {
-    throw std::bad_alloc();
-  }
-  return p;
-}
-
-// Counts allocations made while it is alive.
-class CountAllocations {
- public:
-  CountAllocations() {
-    g_allocations = 0;
-    g_counting = true;
-  }
-  ~CountAllocations() { g_counting = false; }
-  CountAllocations(const CountAllocations&) = delete;
-  CountAllocations& operator=(const CountAllocations&) = delete;
-  [[nodiscard]] long count() const { return g_allocations.load(); }
-};
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  return alloc_or_throw(size, alignof(std::max_align_t));
-}
-void* operator new[](std::size_t size) {
-  return alloc_or_throw(size, alignof(std::max_align_t));
-}
-void* operator new(std::size_t size, std::align_val_t align) {
-  return alloc_or_throw(size, static_cast<std::size_t>(align));
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  return alloc_or_throw(size, static_cast<std::size_t>(align));
-}
-void* operator new(std::size_t size, const std::nothrow_t& /*tag*/) noexcept {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void* operator new[](std::size_t size, const std::nothrow_t& /*tag*/) noexcept {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t /*size*/) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t /*size*/) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::align_val_t /*align*/) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::align_val_t /*align*/) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t /*size*/, std::align_val_t /*align*/) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t /*size*/, std::align_val_t /*align*/) noexcept {
-  std::free(p);
-}
+using pamdp::testing::alloc::CountAllocations;
 
 namespace pamdp {
 namespace {

@@ -12,94 +12,11 @@
 
 #include "core/transport.hpp"
 #include "core/wire.hpp"
+#include "counting_new.hpp"
 #include "replay/shard_server.hpp"
 
-namespace {
-
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-// Only allocations made on threads that opted in are counted (the shard's loop, or the test).
-thread_local bool t_counted_thread = false;
-
-void* counted_alloc(std::size_t size, std::size_t align) {
-  if (t_counted_thread && g_counting.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (size == 0) {
-    size = 1;
-  }
-  if (align <= alignof(std::max_align_t)) {
-    return std::malloc(size);
-  }
-  return std::aligned_alloc(align, (size + align - 1) / align * align);
-}
-
-void* alloc_or_throw(std::size_t size, std::size_t align) {
-  void* p = counted_alloc(size, align);
-  if (p == nullptr) {
-    throw std::bad_alloc();
-  }
-  return p;
-}
-
-class CountAllocations {
- public:
-  CountAllocations() {
-    g_allocations = 0;
-    g_counting = true;
-  }
-  ~CountAllocations() { g_counting = false; }
-  CountAllocations(const CountAllocations&) = delete;
-  CountAllocations& operator=(const CountAllocations&) = delete;
-  [[nodiscard]] long count() const { return g_allocations.load(); }
-};
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  return alloc_or_throw(size, alignof(std::max_align_t));
-}
-void* operator new[](std::size_t size) {
-  return alloc_or_throw(size, alignof(std::max_align_t));
-}
-void* operator new(std::size_t size, std::align_val_t align) {
-  return alloc_or_throw(size, static_cast<std::size_t>(align));
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  return alloc_or_throw(size, static_cast<std::size_t>(align));
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  return counted_alloc(size, alignof(std::max_align_t));
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
-  std::free(p);
-}
-
 namespace pamdp {
+namespace alloc = testing::alloc;
 namespace {
 
 constexpr int kObs = 58;  // HFO widths
@@ -140,7 +57,7 @@ ShardConfig hfo_config() {
 }
 
 TEST(ReplayAlloc, ShardInsertAndSampleThroughTheWireAllocateNothing) {
-  t_counted_thread = true;
+  alloc::count_this_thread(true);
   ReplayShard shard(hfo_config(), 64);
   flatbuffers::FlatBufferBuilder in(1 << 16);
   flatbuffers::FlatBufferBuilder out(1 << 16);
@@ -156,7 +73,7 @@ TEST(ReplayAlloc, ShardInsertAndSampleThroughTheWireAllocateNothing) {
     ASSERT_NE(wire::open_envelope(wire::bytes_of(out)), nullptr);
   };
   round();  // the builders reach their size
-  CountAllocations counter;
+  alloc::CountAllocations counter(/*only_marked_threads=*/true);
   for (int i = 0; i < 200; ++i) {
     round();
   }
@@ -178,7 +95,7 @@ TEST(ReplayAlloc, ServerLoopAllocatesNothingInSteadyState) {
   config.heartbeat_ms = 10;  // several heartbeats inside the counted window
   ShardServer server(ctx, o, [config](const std::string&) { return config; });
   std::thread loop([&] {
-    t_counted_thread = true;
+    alloc::count_this_thread(true);
     server.run();
   });
 
@@ -209,7 +126,7 @@ TEST(ReplayAlloc, ServerLoopAllocatesNothingInSteadyState) {
   }
   long allocations = 0;
   {
-    CountAllocations counter;
+    alloc::CountAllocations counter(/*only_marked_threads=*/true);
     const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < 300; ++i) {
       round();
