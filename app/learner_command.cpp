@@ -16,6 +16,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
@@ -63,10 +64,7 @@ void run_learner(const LearnerCliOptions& o) {
       c.seed = static_cast<uint64_t>(o.seed);
     }
     if (o.run_dir.empty()) {
-      const std::time_t t = std::time(nullptr);
-      char stamp[32];
-      std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&t));
-      run_dir = "runs/" + std::string(stamp) + "-cluster-seed" + std::to_string(c.seed);
+      run_dir = timestamped_run_dir("cluster-seed" + std::to_string(c.seed));
     } else {
       run_dir = o.run_dir;
     }
@@ -127,12 +125,7 @@ void run_learner(const LearnerCliOptions& o) {
     episodes << "episode,wall_seconds,updates,actor,return,steps,status\n";
   }
 
-  struct Recent {
-    float ret;
-    uint32_t steps;
-    bool success;
-  };
-  std::deque<Recent> recent;
+  RecentEpisodes recent;
   UpdateStats last_stats;
   EvalResult last_eval;
   bool have_eval = false;
@@ -158,10 +151,7 @@ void run_learner(const LearnerCliOptions& o) {
   server.on_episode = [&](const EpisodeSummary& e) {
     ++episode_count;
     const bool success = e.status == env->success_status();
-    recent.push_back({e.ret, e.steps, success});
-    if (recent.size() > 100) {
-      recent.pop_front();
-    }
+    recent.add(e.ret, e.steps, success);
     episodes << episode_count << ',' << elapsed() << ',' << ddpg.updates() << ',' << e.actor_id << ',' << e.ret << ','
              << e.steps << ',' << env->status_name(e.status) << '\n';
   };
@@ -182,22 +172,13 @@ void run_learner(const LearnerCliOptions& o) {
     last_tick = now;
     last_updates = ddpg.updates();
     last_samples = k.samples_received;
-    double ret = 0.0;
-    double steps = 0.0;
-    int goals = 0;
-    for (const auto& r : recent) {
-      ret += r.ret;
-      steps += r.steps;
-      goals += r.success ? 1 : 0;
-    }
-    const double n = std::max<double>(1.0, static_cast<double>(recent.size()));
     if (now - last_checkpoint >= c.train.checkpoint_every_seconds && c.train.checkpoint_every_seconds > 0) {
       save();
     }
-    metrics << now << ',' << ddpg.updates() << ',' << episode_count << ',' << goals / n << ',' << ret / n << ','
-            << steps / n << ',' << last_stats.critic_loss << ',' << last_stats.q_mean << ',' << ups << ',' << sps << ','
-            << k.shards << ',' << k.actors_joined << ',' << k.weights_version << ',' << k.malformed_messages << ','
-            << k.waiting_for_data_ms << ',';
+    metrics << now << ',' << ddpg.updates() << ',' << episode_count << ',' << recent.success_rate() << ','
+            << recent.mean_return() << ',' << recent.mean_steps() << ',' << last_stats.critic_loss << ','
+            << last_stats.q_mean << ',' << ups << ',' << sps << ',' << k.shards << ',' << k.actors_joined << ','
+            << k.weights_version << ',' << k.malformed_messages << ',' << k.waiting_for_data_ms << ',';
     if (have_eval) {
       metrics << last_eval.goal_rate << ',' << last_eval.avg_steps_to_goal << ',' << last_eval.avg_return;
     } else {
@@ -210,9 +191,10 @@ void run_learner(const LearnerCliOptions& o) {
       std::printf(
           "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | %.0f updates/s | %.0f "
           "samples/s | shards %lld | actors %lld | weights v%lld%s%s\n",
-          now, static_cast<long long>(ddpg.updates()), static_cast<long long>(episode_count), recent.size(), goals / n,
-          ret / n, ups, sps, static_cast<long long>(k.shards), static_cast<long long>(k.actors_joined),
-          static_cast<long long>(k.weights_version), k.shards == 0 ? " | waiting: no replay shard has joined" : "",
+          now, static_cast<long long>(ddpg.updates()), static_cast<long long>(episode_count), recent.size(),
+          recent.success_rate(), recent.mean_return(), ups, sps, static_cast<long long>(k.shards),
+          static_cast<long long>(k.actors_joined), static_cast<long long>(k.weights_version),
+          k.shards == 0 ? " | waiting: no replay shard has joined" : "",
           (k.shards > 0 && ups == 0.0) ? " | waiting: shards have too little data (warm-up / rate limit)" : "");
       std::fflush(stdout);
     }

@@ -11,6 +11,7 @@
 
 #include "app/commands.hpp"
 #include "app/experiment_config.hpp"
+#include "app/run_support.hpp"
 #include "app/trainer.hpp"
 
 namespace pamdp::app {
@@ -31,13 +32,6 @@ struct TrainCliOptions {
   bool quiet = false;
   bool json = false;
 };
-
-std::string default_run_dir(uint64_t seed) {
-  const std::time_t t = std::time(nullptr);
-  char stamp[32];
-  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&t));
-  return "runs/" + std::string(stamp) + "-seed" + std::to_string(seed);
-}
 
 void run_train(const TrainCliOptions& o) {
   namespace fs = std::filesystem;
@@ -62,7 +56,7 @@ void run_train(const TrainCliOptions& o) {
     if (o.seed >= 0) {
       config.seed = static_cast<uint64_t>(o.seed);
     }
-    opts.run_dir = o.run_dir.empty() ? default_run_dir(config.seed) : o.run_dir;
+    opts.run_dir = o.run_dir.empty() ? timestamped_run_dir("seed" + std::to_string(config.seed)) : o.run_dir;
     if (fs::exists(fs::path(opts.run_dir) / "checkpoint.ckpt")) {
       throw std::runtime_error("run directory '" + opts.run_dir + "' already holds a run; continue it with --resume " +
                                opts.run_dir + " or choose another --run-dir");

@@ -12,6 +12,7 @@
 #include "actor/exploration.hpp"
 #include "app/actor_policy.hpp"
 #include "app/env_factory.hpp"
+#include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
@@ -76,12 +77,6 @@ class EpisodeBuffer {
   std::vector<float> states_, next_, actions_, rewards_, returns_;
 };
 
-struct EpisodeStat {
-  float ret;
-  int steps;
-  bool success;
-};
-
 class Trainer {
  public:
   Trainer(const ExperimentConfig& c, TrainOptions o)
@@ -137,7 +132,7 @@ class Trainer {
   double update_credit_ = 0.0;
   double base_seconds_ = 0.0;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  std::deque<EpisodeStat> recent_;
+  RecentEpisodes recent_;
   UpdateStats last_stats_;
   EvalResult last_eval_;
   bool have_eval_ = false;
@@ -213,20 +208,11 @@ void Trainer::log_tick(bool force) {
   last_log_ = now;
   log_updates_ = ddpg_.updates();
   log_steps_ = env_steps_;
-  double ret = 0.0;
-  double steps = 0.0;
-  int goals = 0;
-  for (const auto& e : recent_) {
-    ret += e.ret;
-    steps += e.steps;
-    goals += e.success ? 1 : 0;
-  }
-  const double n = std::max<double>(1.0, static_cast<double>(recent_.size()));
   const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                     exploration_.epsilon_anneal_updates);
-  metrics_ << now << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << episodes_ << ',' << eps << ',' << goals / n
-           << ',' << ret / n << ',' << steps / n << ',' << last_stats_.critic_loss << ',' << last_stats_.q_mean << ','
-           << ups << ',' << sps << ',';
+  metrics_ << now << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << episodes_ << ',' << eps << ','
+           << recent_.success_rate() << ',' << recent_.mean_return() << ',' << recent_.mean_steps() << ','
+           << last_stats_.critic_loss << ',' << last_stats_.q_mean << ',' << ups << ',' << sps << ',';
   if (have_eval_) {
     metrics_ << last_eval_.goal_rate << ',' << last_eval_.avg_steps_to_goal << ',' << last_eval_.avg_return;
   } else {
@@ -239,8 +225,9 @@ void Trainer::log_tick(bool force) {
         "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | eps %.3f | loss %.4g | Q %.3f "
         "| "
         "%.0f updates/s | %.0f steps/s",
-        now, static_cast<long long>(ddpg_.updates()), static_cast<long long>(episodes_), recent_.size(), goals / n,
-        ret / n, eps, static_cast<double>(last_stats_.critic_loss), static_cast<double>(last_stats_.q_mean), ups, sps);
+        now, static_cast<long long>(ddpg_.updates()), static_cast<long long>(episodes_), recent_.size(),
+        recent_.success_rate(), recent_.mean_return(), eps, static_cast<double>(last_stats_.critic_loss),
+        static_cast<double>(last_stats_.q_mean), ups, sps);
     if (have_eval_) {
       std::printf(" | eval %.2f", last_eval_.goal_rate);
     }
@@ -323,10 +310,7 @@ TrainSummary Trainer::run() {
     episode_.flush(replay_, c_.ddpg.gamma);
     ++episodes_;
     const bool success = sr.status == env_->success_status();
-    recent_.push_back({ep_return, steps, success});
-    if (recent_.size() > 100) {
-      recent_.pop_front();
-    }
+    recent_.add(ep_return, steps, success);
     episodes_csv_ << episodes_ << ',' << elapsed() << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << ep_return
                   << ',' << steps << ',' << env_->status_name(sr.status) << '\n';
     if (ddpg_.updates() >= next_eval_) {

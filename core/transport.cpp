@@ -273,6 +273,22 @@ bool Socket::wait_readable(int timeout_ms) {
   return wait_for(raw(), ZMQ_POLLIN, timeout_ms);
 }
 
+std::string advertised_endpoint(const std::string& bound, const std::string& host) {
+  const std::string tcp = "tcp://";
+  if (bound.rfind(tcp, 0) != 0) {
+    return bound;
+  }
+  const size_t colon = bound.rfind(':');
+  if (colon == std::string::npos || colon < tcp.size()) {
+    return bound;
+  }
+  const std::string bound_host = bound.substr(tcp.size(), colon - tcp.size());
+  if (bound_host == "0.0.0.0" || bound_host == "*" || bound_host == "[::]" || bound_host == "::") {
+    return tcp + host + bound.substr(colon);
+  }
+  return bound;
+}
+
 void Poller::add(Socket& s) {
   sockets_.push_back(s.raw());
   revents_.push_back(0);

@@ -114,6 +114,10 @@ class Socket {
   void* sock_ = nullptr;  // the ZeroMQ socket handle
 };
 
+// The address peers use for a bound endpoint: a wildcard host (tcp://*:P, tcp://0.0.0.0:P,
+// IPv6 wildcards) becomes tcp://<host>:P; anything else is returned unchanged.
+std::string advertised_endpoint(const std::string& bound, const std::string& host);
+
 // Waits on several sockets at once; returns the indices of the readable ones.
 class Poller {
  public:

@@ -49,20 +49,11 @@ LearnerServer::LearnerServer(net::Context& ctx, Ddpg& ddpg, LearnerServerConfig 
     join_.make_curve_server(*config_.curve);
     weights_.make_curve_server(*config_.curve);
   }
-  join_endpoint_ = connectable(join_.bind(config_.join_bind));
-  weights_endpoint_ = connectable(weights_.bind(config_.weights_bind));
+  join_endpoint_ = net::advertised_endpoint(join_.bind(config_.join_bind), config_.advertise_host);
+  weights_endpoint_ = net::advertised_endpoint(weights_.bind(config_.weights_bind), config_.advertise_host);
 }
 
 LearnerServer::~LearnerServer() = default;
-
-std::string LearnerServer::connectable(const std::string& bound) const {
-  // tcp://0.0.0.0:PORT (from tcp://*:PORT) is not an address a peer can use.
-  const std::string wildcard = "tcp://0.0.0.0:";
-  if (bound.rfind(wildcard, 0) == 0) {
-    return "tcp://" + config_.advertise_host + ":" + bound.substr(wildcard.size());
-  }
-  return bound;
-}
 
 void LearnerServer::note_malformed(const char* what) {
   ++counters_.malformed_messages;

@@ -90,7 +90,6 @@ class LearnerServer {
   void request_samples(Shard& shard);
   void drop_dead_shards();
   void send_map(std::span<const uint8_t> identity, uint32_t actor_index);
-  std::string connectable(const std::string& bound) const;
   void note_malformed(const char* what);
 
   net::Context& ctx_;

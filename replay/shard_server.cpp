@@ -28,21 +28,6 @@ constexpr int kJoinSendHwm = 16;                           // stale heartbeats t
 constexpr int kDrainBudget = 64;
 
 // tcp://0.0.0.0:PORT (what ZeroMQ reports for tcp://*:0) becomes tcp://HOST:PORT.
-std::string advertised(const std::string& bound, const std::string& host) {
-  const std::string tcp = "tcp://";
-  if (bound.rfind(tcp, 0) != 0) {
-    return bound;
-  }
-  const size_t colon = bound.rfind(':');
-  if (colon == std::string::npos || colon < tcp.size()) {
-    return bound;
-  }
-  const std::string bound_host = bound.substr(tcp.size(), colon - tcp.size());
-  if (bound_host == "0.0.0.0" || bound_host == "*" || bound_host == "[::]" || bound_host == "::") {
-    return tcp + host + bound.substr(colon);
-  }
-  return bound;
-}
 
 // Throws std::runtime_error if a config from the learner cannot make a shard (the checks that
 // would otherwise be hard checks in ReplayBuffer and RateLimiter).
@@ -192,8 +177,8 @@ ShardServer::ShardServer(net::Context& ctx, ShardServerOptions options, ShardCon
   if (options_.curve_client) {
     join_.make_curve_client(*options_.curve_client);
   }
-  insert_endpoint_ = advertised(insert_.bind(options_.insert_bind), options_.advertise_host);
-  sample_endpoint_ = advertised(sample_.bind(options_.sample_bind), options_.advertise_host);
+  insert_endpoint_ = net::advertised_endpoint(insert_.bind(options_.insert_bind), options_.advertise_host);
+  sample_endpoint_ = net::advertised_endpoint(sample_.bind(options_.sample_bind), options_.advertise_host);
   join_.connect(options_.join_endpoint);
 
   poll_all_.add(join_);
