@@ -10,15 +10,6 @@
 namespace pamdp::app {
 namespace {
 
-template <typename E>
-using Choices = std::vector<std::pair<std::string, E>>;
-
-const Choices<hfo::StartDistribution> kStarts{{"paper", hfo::StartDistribution::kPaper},
-                                              {"dec2015", hfo::StartDistribution::kDec2015},
-                                              {"hfo", hfo::StartDistribution::kHfo}};
-const Choices<hfo::Referee> kReferees{{"server", hfo::Referee::kServer}, {"trainer", hfo::Referee::kTrainer}};
-const Choices<hfo::BodyAtReset> kBodies{
-    {"carry", hfo::BodyAtReset::kCarry}, {"zero", hfo::BodyAtReset::kZero}, {"uniform", hfo::BodyAtReset::kUniform}};
 const Choices<BoundMethod> kBounds{
     {"inverting", BoundMethod::kInverting}, {"zeroing", BoundMethod::kZeroing}, {"squashing", BoundMethod::kSquashing}};
 const Choices<std::string> kEnvs{{"hfo", "hfo"}, {"reach_stop", "reach_stop"}};
@@ -41,9 +32,9 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("seed", c.seed, 0, INT64_MAX);
   v.choice("env.name", c.env.name, kEnvs);
   v.boolean("env.noise", c.env.hfo.noise);
-  v.choice("env.start", c.env.hfo.start, kStarts);
-  v.choice("env.referee", c.env.hfo.referee, kReferees);
-  v.choice("env.body_at_reset", c.env.hfo.body_at_reset, kBodies);
+  v.choice("env.start", c.env.hfo.start, start_choices());
+  v.choice("env.referee", c.env.hfo.referee, referee_choices());
+  v.choice("env.body_at_reset", c.env.hfo.body_at_reset, body_at_reset_choices());
   v.integer("env.max_steps", c.env.hfo.max_steps, 1, 1000000);
   v.integer("env.untouched_limit", c.env.hfo.untouched_limit, 1, 1000000);
 
@@ -387,6 +378,24 @@ void validate(const ExperimentConfig& c, const std::string& src) {
 }
 
 }  // namespace
+
+const Choices<hfo::StartDistribution>& start_choices() {
+  static const Choices<hfo::StartDistribution> kChoices{{"paper", hfo::StartDistribution::kPaper},
+                                                        {"dec2015", hfo::StartDistribution::kDec2015},
+                                                        {"hfo", hfo::StartDistribution::kHfo}};
+  return kChoices;
+}
+
+const Choices<hfo::Referee>& referee_choices() {
+  static const Choices<hfo::Referee> kChoices{{"server", hfo::Referee::kServer}, {"trainer", hfo::Referee::kTrainer}};
+  return kChoices;
+}
+
+const Choices<hfo::BodyAtReset>& body_at_reset_choices() {
+  static const Choices<hfo::BodyAtReset> kChoices{
+      {"carry", hfo::BodyAtReset::kCarry}, {"zero", hfo::BodyAtReset::kZero}, {"uniform", hfo::BodyAtReset::kUniform}};
+  return kChoices;
+}
 
 ExperimentConfig parse_experiment_config(const std::string& toml_text, const std::string& source_name,
                                          const std::vector<std::string>& overrides) {

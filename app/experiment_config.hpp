@@ -70,6 +70,13 @@ struct ExperimentConfig {
   ClusterConfig cluster;
 };
 
+// Names of the enum-valued settings, shared by the config file and the command-line options.
+template <typename E>
+using Choices = std::vector<std::pair<std::string, E>>;
+const Choices<hfo::StartDistribution>& start_choices();
+const Choices<hfo::Referee>& referee_choices();
+const Choices<hfo::BodyAtReset>& body_at_reset_choices();
+
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws
 // std::runtime_error with the key, the problem and the valid choices.
 ExperimentConfig load_experiment_config(const std::string& path, const std::vector<std::string>& overrides);

@@ -5,6 +5,7 @@
 #include <map>
 #include <string>
 
+#include "app/experiment_config.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 
 namespace pamdp::app {
@@ -15,21 +16,16 @@ struct SimOptions {
 
   void add_to(CLI::App& cmd) {
     cmd.add_flag("--no-noise", no_noise, "switch off movement, turn, kick and tackle noise");
-    const std::map<std::string, pamdp::hfo::StartDistribution> starts{
-        {"paper", pamdp::hfo::StartDistribution::kPaper},
-        {"dec2015", pamdp::hfo::StartDistribution::kDec2015},
-        {"hfo", pamdp::hfo::StartDistribution::kHfo}};
+    const std::map<std::string, pamdp::hfo::StartDistribution> starts(start_choices().begin(), start_choices().end());
     cmd.add_option("--start", config.start, "start distribution: paper (E1), dec2015 (E2), hfo (E3)")
         ->transform(CLI::CheckedTransformer(starts, CLI::ignore_case))
         ->default_str("paper");
-    const std::map<std::string, pamdp::hfo::Referee> referees{{"server", pamdp::hfo::Referee::kServer},
-                                                              {"trainer", pamdp::hfo::Referee::kTrainer}};
+    const std::map<std::string, pamdp::hfo::Referee> referees(referee_choices().begin(), referee_choices().end());
     cmd.add_option("--referee", config.referee, "episode rules: server (HFORef, default) or trainer (paper era)")
         ->transform(CLI::CheckedTransformer(referees, CLI::ignore_case))
         ->default_str("server");
-    const std::map<std::string, pamdp::hfo::BodyAtReset> bodies{{"carry", pamdp::hfo::BodyAtReset::kCarry},
-                                                                {"zero", pamdp::hfo::BodyAtReset::kZero},
-                                                                {"uniform", pamdp::hfo::BodyAtReset::kUniform}};
+    const std::map<std::string, pamdp::hfo::BodyAtReset> bodies(body_at_reset_choices().begin(),
+                                                                body_at_reset_choices().end());
     cmd.add_option("--body-reset", config.body_at_reset, "body angle at episode start: carry, zero, uniform")
         ->transform(CLI::CheckedTransformer(bodies, CLI::ignore_case))
         ->default_str("carry");
