@@ -14,6 +14,9 @@ packages=(
   nlohmann-json3-dev       # JSON in and out (--json, STATE.json)
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev         # pamdp-bench
+  libcpp-httplib-dev       # the /metrics endpoint of every process (Prometheus text format)
+  gnuplot-nox              # pamdp plot (learning-curve PNGs)
+  prometheus               # the test that scrapes a running cluster with a real Prometheus
   clang-format             # tests/run.sh checks formatting
 )
 
