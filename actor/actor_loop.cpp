@@ -203,7 +203,8 @@ struct ActorLoop::Impl {
   Impl(net::Context& ctx, LearnerLink link, const ClusterInfo& map, std::vector<std::unique_ptr<Env>> env_list,
        ActorLoopConfig config, ActorCounters& counters);
 
-  void run(const std::atomic<bool>& stop, const std::function<void(const ActorCounters&, double)>& on_tick);
+  void run(const std::atomic<bool>& stop, const std::function<void(const ActorCounters&, double)>& on_tick,
+           const std::function<void(int, double, int)>& on_episode);
 
   void step(EnvSlot& slot);
   void forward(std::span<const float> obs);
@@ -270,6 +271,7 @@ struct ActorLoop::Impl {
   // Timing and state of the control plane.
   const std::atomic<bool>* stop = nullptr;
   const std::function<void(const ActorCounters&, double)>* on_tick = nullptr;
+  const std::function<void(int, double, int)>* on_episode = nullptr;
   Clock::time_point next_control, next_heartbeat, next_tick, learner_heard, rejoin_sent, last_malformed_log;
   bool rejoin_pending = false;
   bool learner_silent = false;
@@ -313,9 +315,11 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
 // Acting
 
 void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
-                          const std::function<void(const ActorCounters&, double)>& tick) {
+                          const std::function<void(const ActorCounters&, double)>& tick,
+                          const std::function<void(int, double, int)>& episode_end) {
   stop = &stop_flag;
   on_tick = &tick;
+  on_episode = &episode_end;
   const auto now = Clock::now();
   next_control = now;
   next_heartbeat = now;
@@ -340,6 +344,7 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
             counters.episodes.load(), counters.batches_sent.load());
   stop = nullptr;
   on_tick = nullptr;
+  on_episode = nullptr;
 }
 
 void ActorLoop::Impl::reset(EnvSlot& slot) {
@@ -393,6 +398,9 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), static_cast<float>(slot.ret),
                                 static_cast<uint32_t>(slot.steps), status, weights_version)) {
     counters.reports_dropped.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (on_episode != nullptr && *on_episode) {
+    (*on_episode)(status, slot.ret, slot.steps);
   }
   reset(slot);
 }
@@ -513,6 +521,8 @@ void ActorLoop::Impl::serve_control(Clock::time_point now) {
   next_control = now + kControlPeriod;
   poll_weights();
   poll_learner(now);
+  counters.weights_age_updates.store(policy != nullptr ? std::max<int64_t>(0, link.learner_updates() - updates) : 0,
+                                     std::memory_order_relaxed);
   if (now >= next_heartbeat) {
     heartbeat(now);
     next_heartbeat = now + std::chrono::milliseconds(config.heartbeat_ms);
@@ -620,6 +630,7 @@ void ActorLoop::Impl::update_epsilon() {
   } else {
     eps = linear_epsilon(updates, e.epsilon_start, e.epsilon_end, e.epsilon_anneal_updates);
   }
+  counters.epsilon.store(eps, std::memory_order_relaxed);
 }
 
 void ActorLoop::Impl::heard_learner(Clock::time_point now) {
@@ -755,7 +766,7 @@ ActorLoop::ActorLoop(net::Context& ctx, LearnerLink link, const ClusterInfo& map
 ActorLoop::~ActorLoop() = default;
 
 void ActorLoop::run(const std::atomic<bool>& stop) {
-  impl_->run(stop, on_tick);
+  impl_->run(stop, on_tick, on_episode);
 }
 
 uint32_t ActorLoop::actor_index() const {

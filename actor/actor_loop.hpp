@@ -72,6 +72,10 @@ struct ActorCounters {
   std::atomic<int64_t> malformed_messages{0};
   std::atomic<int64_t> send_blocked_ms{0};
   std::atomic<int64_t> reports_dropped{0};  // EpisodeReports the join socket would not take
+  std::atomic<double> epsilon{1.0};         // ε the next step uses
+  // Learner updates between the weights this actor acts with and the newest update count it has
+  // heard of (heartbeat answers, weights); 0 before the first weights.
+  std::atomic<int64_t> weights_age_updates{0};
 };
 
 class ActorLoop {
@@ -90,6 +94,9 @@ class ActorLoop {
 
   // Called on the run() thread about every tick_ms (progress lines); may be empty.
   std::function<void(const ActorCounters&, double epsilon)> on_tick;
+  // Called on the run() thread at the end of every episode (metrics) with the env's terminal
+  // status, the undiscounted return and the steps; may be empty; must not allocate.
+  std::function<void(int status, double ret, int steps)> on_episode;
 
   [[nodiscard]] uint32_t actor_index() const;
   // ε the next step uses. Run thread only.

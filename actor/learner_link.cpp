@@ -60,6 +60,7 @@ struct LearnerLink::Impl {
   flatbuffers::FlatBufferBuilder fbb{4096};
   net::Message msg;
   int64_t malformed_during_join = 0;
+  int64_t learner_updates = 0;
 
   Impl(net::Context& c, LearnerLinkConfig cfg) : ctx(&c), config(std::move(cfg)), dealer(make_dealer(c, config)) {}
 };
@@ -73,12 +74,16 @@ LearnerLink& LearnerLink::operator=(LearnerLink&&) noexcept = default;
 const LearnerLinkConfig& LearnerLink::config() const {
   return impl_->config;
 }
+int64_t LearnerLink::learner_updates() const {
+  return impl_->learner_updates;
+}
 int64_t LearnerLink::malformed_during_join() const {
   return impl_->malformed_during_join;
 }
 
 bool LearnerLink::send_join_request() {
-  wire::build_join_request(impl_->fbb, wire::Role::Actor, impl_->config.name, "", "", impl_->config.actor_envs);
+  wire::build_join_request(impl_->fbb, wire::Role::Actor, impl_->config.name, "", "", impl_->config.actor_envs,
+                           impl_->config.metrics_url);
   return impl_->dealer.send(wire::bytes_of(impl_->fbb), 0);
 }
 
@@ -106,9 +111,15 @@ LearnerLink::Received LearnerLink::receive(ClusterInfo& map, uint64_t& learner_m
     return Received::kMalformed;
   }
   switch (env->payload_type()) {
-    case wire::Payload::Heartbeat:
-      learner_map_version = env->payload_as_Heartbeat()->map_version();
+    case wire::Payload::Heartbeat: {
+      const wire::Heartbeat* hb = env->payload_as_Heartbeat();
+      learner_map_version = hb->map_version();
+      // The learner's counters: updates first (learner_server.cpp).
+      if (hb->counters() != nullptr && hb->counters()->size() > 0) {
+        impl_->learner_updates = hb->counters()->Get(0);
+      }
       return Received::kHeartbeat;
+    }
     case wire::Payload::ClusterMap:
       return copy_map(env->payload_as_ClusterMap(), map) ? Received::kClusterMap : Received::kMalformed;
     default: return Received::kMalformed;

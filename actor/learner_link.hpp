@@ -44,6 +44,7 @@ struct LearnerLinkConfig {
   // late then sees one request, not a backlog of them).
   int join_retry_ms = 2000;
   int join_timeout_ms = 0;  // join() gives up after this long; 0 = until stopped
+  std::string metrics_url;  // told to the learner in every JoinRequest; may be empty
   std::optional<net::CurveClientKeys> curve;
 };
 
@@ -75,6 +76,8 @@ class LearnerLink {
   // Waits until receive() has something (or timeout_ms passes); false on timeout.
   bool wait_readable(int timeout_ms);
 
+  // The learner's update count in its newest heartbeat answer (0 before the first).
+  [[nodiscard]] int64_t learner_updates() const;
   // Malformed messages seen by join() (receive() leaves the counting to its caller).
   [[nodiscard]] int64_t malformed_during_join() const;
   [[nodiscard]] const LearnerLinkConfig& config() const;

@@ -85,12 +85,13 @@ TransitionRows rows_of(const TransitionBatch* b) {
 
 void build_join_request(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name,
                         const std::string& shard_insert_endpoint, const std::string& shard_sample_endpoint,
-                        uint32_t actor_envs) {
+                        uint32_t actor_envs, const std::string& metrics_url) {
   fbb.Clear();
   const auto n = fbb.CreateString(name);
   const auto e = fbb.CreateString(shard_insert_endpoint);
   const auto s = fbb.CreateString(shard_sample_endpoint);
-  finish(fbb, Payload::JoinRequest, CreateJoinRequest(fbb, role, n, e, actor_envs, s).Union());
+  const auto m = fbb.CreateString(metrics_url);
+  finish(fbb, Payload::JoinRequest, CreateJoinRequest(fbb, role, n, e, actor_envs, s, m).Union());
 }
 
 void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, const std::string& config_toml,
@@ -145,6 +146,17 @@ void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::
   const auto n = fbb.CreateString(name);
   const auto c = fbb.CreateVector(counters.data(), counters.size());
   finish(fbb, Payload::Heartbeat, CreateHeartbeat(fbb, role, n, map_version, c).Union());
+}
+
+void build_metrics_urls_request(flatbuffers::FlatBufferBuilder& fbb) {
+  fbb.Clear();
+  finish(fbb, Payload::MetricsUrlsRequest, CreateMetricsUrlsRequest(fbb).Union());
+}
+
+void build_metrics_urls(flatbuffers::FlatBufferBuilder& fbb, const std::vector<std::string>& urls) {
+  fbb.Clear();
+  const auto u = fbb.CreateVectorOfStrings(urls);
+  finish(fbb, Payload::MetricsUrls, CreateMetricsUrls(fbb, u).Union());
 }
 
 }  // namespace pamdp::wire

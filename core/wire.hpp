@@ -47,7 +47,7 @@ TransitionRows rows_of(const TransitionBatch* batch);
 
 void build_join_request(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name,
                         const std::string& shard_insert_endpoint, const std::string& shard_sample_endpoint,
-                        uint32_t actor_envs);
+                        uint32_t actor_envs, const std::string& metrics_url = "");
 void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, const std::string& config_toml,
                        const std::vector<std::string>& shard_insert_endpoints,
                        const std::vector<std::string>& shard_sample_endpoints, const std::string& weights_endpoint,
@@ -62,5 +62,7 @@ void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id
                           uint32_t steps, int32_t status, uint64_t policy_version);
 void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,
                      std::span<const int64_t> counters);
+void build_metrics_urls_request(flatbuffers::FlatBufferBuilder& fbb);
+void build_metrics_urls(flatbuffers::FlatBufferBuilder& fbb, const std::vector<std::string>& urls);
 
 }  // namespace pamdp::wire

@@ -38,6 +38,7 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   if (config.batch_size < 1) {
     throw std::invalid_argument("ddpg.batch_size must be >= 1");
   }
+  num_actions_ = space.num_actions();
   Rng rng(seed);
   const auto s = static_cast<float>(config.init_std);
   actor_.init_gaussian(rng, s);
@@ -114,6 +115,15 @@ UpdateStats Ddpg::update(const BatchView& batch) {
 
   // 3. Actor step through the updated critic: dLoss/dQ = -1 per sample (a sum, not a mean).
   actor_outputs(actor_, batch.states, B, actions_);
+  int at_bound = 0;
+  for (int j = 0; j < B; ++j) {
+    for (int i = num_actions_; i < W; ++i) {
+      const float a = actions_(i, j);
+      at_bound += (a <= bounds_.lo[static_cast<size_t>(i)] || a >= bounds_.hi[static_cast<size_t>(i)]) ? 1 : 0;
+    }
+  }
+  stats.params_at_bound_fraction =
+      W > num_actions_ ? static_cast<float>(at_bound) / static_cast<float>((W - num_actions_) * B) : 0.0F;
   critic_in_.topLeftCorner(obs_dim_, B) = batch.states;
   critic_in_.bottomLeftCorner(W, B) = actions_.leftCols(B);
   critic_.forward(critic_in_.leftCols(B));

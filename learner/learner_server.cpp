@@ -34,9 +34,10 @@ int64_t ms_since(Clock::time_point t) {
 
 }  // namespace
 
-LearnerServer::LearnerServer(net::Context& ctx, Ddpg& ddpg, LearnerServerConfig config)
+LearnerServer::LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerServerConfig config)
     : ctx_(ctx),
-      ddpg_(ddpg),
+      backend_(backend),
+      ddpg_(backend.ddpg()),
       config_(std::move(config)),
       join_(ctx, net::SocketType::kRouter),
       weights_(ctx, net::SocketType::kPub),
@@ -76,6 +77,7 @@ void LearnerServer::send_map(std::span<const uint8_t> identity, uint32_t actor_i
 }
 
 void LearnerServer::publish_weights() {
+  backend_.sync_actor_to_host();
   Mlp<float>& actor = ddpg_.actor();
   ++counters_.weights_version;
   wire::build_policy_weights(fbb_->weights, static_cast<uint64_t>(counters_.weights_version), ddpg_.updates(),
@@ -94,6 +96,7 @@ void LearnerServer::handle_join_socket() {
       continue;
     }
     const std::vector<uint8_t> id(identity.data(), identity.data() + identity.size());
+    const std::string peer_id(reinterpret_cast<const char*>(identity.data()), identity.size());
     switch (env->payload_type()) {
       case wire::Payload::JoinRequest: {
         const auto* j = env->payload_as_JoinRequest();
@@ -127,6 +130,8 @@ void LearnerServer::handle_join_socket() {
           }
           (*it)->join_identity = id;
           (*it)->last_heard = Clock::now();
+          peers_[peer_id] = {false, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now()};
+          refresh_peers(false);
           send_map(identity.bytes(), 0);
         } else if (j->role() == wire::Role::Actor) {
           // An actor that joins again (its map went stale) keeps its index.
@@ -137,6 +142,8 @@ void LearnerServer::handle_join_socket() {
             log::info("learner: actor {} joined ({}, {} envs)", known->second, j->name() ? j->name()->str() : "?",
                       j->actor_envs());
           }
+          peers_[peer_id] = {true, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now()};
+          refresh_peers(false);
           send_map(identity.bytes(), known->second);
           // The newcomer subscribes only after it has the map: publish again shortly.
           republish_at_ = Clock::now() + std::chrono::milliseconds(200);
@@ -147,6 +154,9 @@ void LearnerServer::handle_join_socket() {
       }
       case wire::Payload::Heartbeat: {
         bool known = actor_index_.count(id) != 0;
+        if (auto peer = peers_.find(peer_id); peer != peers_.end()) {
+          peer->second.last_heard = Clock::now();
+        }
         for (auto& s : shards_) {
           if (s->join_identity == id) {
             s->last_heard = Clock::now();
@@ -164,11 +174,43 @@ void LearnerServer::handle_join_socket() {
         const auto* r = env->payload_as_EpisodeReport();
         ++counters_.episodes;
         if (on_episode) {
-          on_episode({r->actor_id(), r->return_(), r->steps(), r->status()});
+          on_episode({r->actor_id(), r->return_(), r->steps(), r->status(), r->policy_version()});
         }
         break;
       }
+      case wire::Payload::MetricsUrlsRequest:
+        wire::build_metrics_urls(fbb_->fbb, metrics_urls_);
+        join_.send_to(identity.bytes(), wire::bytes_of(fbb_->fbb), 0);
+        break;
       default: note_malformed("unexpected message type on the join socket"); break;
+    }
+  }
+}
+
+void LearnerServer::refresh_peers(bool drop_silent) {
+  if (drop_silent) {
+    std::erase_if(peers_, [&](const auto& p) { return ms_since(p.second.last_heard) > config_.peer_timeout_ms; });
+  }
+  counters_.actors_alive = std::count_if(peers_.begin(), peers_.end(), [](const auto& p) { return p.second.actor; });
+  // The learner first, then shards, then actors, each sorted: a stable order for files and monitors.
+  std::vector<std::string> urls;
+  std::vector<std::string> actors;
+  for (const auto& [id, peer] : peers_) {
+    if (!peer.metrics_url.empty()) {
+      (peer.actor ? actors : urls).push_back(peer.metrics_url);
+    }
+  }
+  std::sort(urls.begin(), urls.end());
+  std::sort(actors.begin(), actors.end());
+  urls.insert(urls.end(), actors.begin(), actors.end());
+  urls.erase(std::unique(urls.begin(), urls.end()), urls.end());
+  if (!config_.metrics_url.empty()) {
+    urls.insert(urls.begin(), config_.metrics_url);
+  }
+  if (urls != metrics_urls_) {
+    metrics_urls_ = std::move(urls);
+    if (on_metrics_urls) {
+      on_metrics_urls(metrics_urls_);
     }
   }
 }
@@ -218,7 +260,7 @@ void LearnerServer::handle_shard(Shard& shard) {
         Eigen::Map<const Eigen::VectorXf>(terminal.data(), B),
         Eigen::Map<const Eigen::VectorXf>(rows.mc_returns, B),
     };
-    const UpdateStats stats = ddpg_.update(view);
+    const UpdateStats stats = backend_.update(view);
     ++counters_.updates;
     counters_.samples_received += B;
     shard.samples += B;
@@ -257,6 +299,13 @@ void LearnerServer::run() {
   bool waiting = false;
   last_published_at_ = ddpg_.updates();
   publish_weights();
+  metrics_urls_.clear();
+  if (!config_.metrics_url.empty()) {
+    metrics_urls_.push_back(config_.metrics_url);
+  }
+  if (on_metrics_urls) {
+    on_metrics_urls(metrics_urls_);
+  }
   net::Poller poller;
   uint64_t poller_version = 0;
   log::info("learner: join {} weights {}", join_endpoint_, weights_endpoint_);
@@ -306,6 +355,7 @@ void LearnerServer::run() {
     if (ms_since(last_tick) >= 1000) {
       last_tick = Clock::now();
       counters_.shards = static_cast<int64_t>(shards_.size());
+      refresh_peers(true);
       if (waiting) {
         counters_.waiting_for_data_ms += ms_since(waiting_since);
         waiting_since = Clock::now();

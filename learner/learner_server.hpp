@@ -22,6 +22,7 @@
 
 #include "core/transport.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/update_backend.hpp"
 
 namespace pamdp {
 
@@ -38,6 +39,7 @@ struct LearnerServerConfig {
   int peer_timeout_ms = 5000;
   int64_t max_updates = INT64_MAX;
   double max_seconds = 0.0;                          // 0 = no limit
+  std::string metrics_url;                           // this learner's own, first in metrics_urls()
   std::optional<net::CurveServerKeys> curve;         // CURVE on both bound sockets when set
   std::optional<net::CurveClientKeys> curve_client;  // for the learner's own connections to shards
 };
@@ -50,6 +52,7 @@ struct LearnerCounters {
   int64_t weights_version = 0;
   int64_t shards = 0;
   int64_t actors_joined = 0;
+  int64_t actors_alive = 0;  // actors heard from within peer_timeout_ms
   int64_t waiting_for_data_ms = 0;
 };
 
@@ -58,12 +61,14 @@ struct EpisodeSummary {
   float ret;
   uint32_t steps;
   int32_t status;
+  uint64_t policy_version;  // weights version the actor played the episode with
 };
 
 class LearnerServer {
  public:
-  // `ddpg` is owned by the caller and must outlive the server.
-  LearnerServer(net::Context& ctx, Ddpg& ddpg, LearnerServerConfig config);
+  // `backend` (and its Ddpg) are owned by the caller and must outlive the server. Updates go
+  // through the backend; weights are synced to the host Ddpg before each broadcast.
+  LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerServerConfig config);
   ~LearnerServer();
 
   // Resolved, connectable endpoints (valid after construction).
@@ -76,16 +81,29 @@ class LearnerServer {
   std::function<void(const EpisodeSummary&)> on_episode;
   // Called about once per second with the counters (progress lines, metrics).
   std::function<void(const LearnerCounters&)> on_tick;
+  // Called on the learner thread when the cluster's metrics URLs change (a peer joins with one,
+  // or is silent for peer_timeout_ms), and once when run() starts.
+  std::function<void(const std::vector<std::string>& urls)> on_metrics_urls;
 
   // Runs until stop(), max_updates or max_seconds.
   void run();
   void stop() { stop_.store(true); }
   [[nodiscard]] const LearnerCounters& counters() const { return counters_; }
+  // The learner's own metrics URL first, then the live peers' (shards, then actors), as served
+  // to `pamdp monitor` (MetricsUrlsRequest). Learner thread only.
+  [[nodiscard]] const std::vector<std::string>& metrics_urls() const { return metrics_urls_; }
   void publish_weights();
 
  private:
   struct Shard;
+  // Every actor and shard that joined, by join-socket identity, for liveness and metrics URLs.
+  struct Peer {
+    bool actor = false;
+    std::string metrics_url;
+    std::chrono::steady_clock::time_point last_heard;
+  };
   void handle_join_socket();
+  void refresh_peers(bool drop_silent);
   void handle_shard(Shard& shard);
   void request_samples(Shard& shard);
   void drop_dead_shards();
@@ -93,6 +111,7 @@ class LearnerServer {
   void note_malformed(const char* what);
 
   net::Context& ctx_;
+  UpdateBackend& backend_;
   Ddpg& ddpg_;
   LearnerServerConfig config_;
   net::Socket join_;
@@ -112,6 +131,8 @@ class LearnerServer {
   std::vector<float> terminal_scratch_;
   net::Message reply_;
   std::optional<std::chrono::steady_clock::time_point> republish_at_;
+  std::map<std::string, Peer> peers_;  // by join-socket identity (bytes)
+  std::vector<std::string> metrics_urls_;
 };
 
 }  // namespace pamdp

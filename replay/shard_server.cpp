@@ -206,6 +206,9 @@ ShardCounters ShardServer::counters() const {
   c.size = size_.load(r);
   c.map_version = map_version_pub_.load(r);
   c.joins = joins_.load(r);
+  c.transitions_dropped = transitions_dropped_.load(r);
+  c.capacity = capacity_.load(r);
+  c.inserts_held = inserts_held_pub_.load(r);
   return c;
 }
 
@@ -288,7 +291,8 @@ void ShardServer::run() {
 }
 
 void ShardServer::send_join(Clock::time_point now) {
-  wire::build_join_request(fbb_, wire::Role::Shard, options_.name, insert_endpoint_, sample_endpoint_, 0);
+  wire::build_join_request(fbb_, wire::Role::Shard, options_.name, insert_endpoint_, sample_endpoint_, 0,
+                           options_.metrics_url);
   join_.send(wire::bytes_of(fbb_), 0);  // a full queue means the learner is away: the retry covers it
   next_join_ = now + std::chrono::milliseconds(joined_ ? heartbeat_ms_ : options_.join_retry_ms);
 }
@@ -463,6 +467,7 @@ void ShardServer::serve_waiting_requests(Clock::time_point now) {
     waiting_now_.store(waiting_count_, std::memory_order_relaxed);
     if (!sample_.send_to({head.identity.data(), head.identity_size}, wire::bytes_of(fbb_), 0)) {
       replies_dropped_.fetch_add(1, std::memory_order_relaxed);
+      transitions_dropped_.fetch_add(head.batch_size, std::memory_order_relaxed);
       if (log_reply_.open(now)) {
         log::warn("replay shard '{}': could not queue a SampleReply (the learner is gone or not reading); {} dropped",
                   options_.name, replies_dropped_.load(std::memory_order_relaxed));
@@ -488,6 +493,8 @@ void ShardServer::publish_counters() {
   blocked_ms_.store(to_ms(blocked_), r);
   size_.store(shard_ != nullptr ? shard_->buffer().size() : 0, r);
   map_version_pub_.store(static_cast<int64_t>(map_version_), r);
+  capacity_.store(shard_ != nullptr ? shard_->config().capacity : 0, r);
+  inserts_held_pub_.store(inserts_held_ ? 1 : 0, r);
 }
 
 }  // namespace pamdp

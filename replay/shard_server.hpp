@@ -108,6 +108,7 @@ struct ShardServerOptions {
   std::string advertise_host = "127.0.0.1";  // replaces * / 0.0.0.0 in the advertised endpoints
   std::string name = "replay";               // for the learner's logs
   std::string snapshot_path;                 // empty: no snapshot
+  std::string metrics_url;                   // told to the learner in the JoinRequest; may be empty
   uint32_t max_batch_transitions = 4096;     // largest TransitionBatch and SampleRequest accepted
   int join_retry_ms = 1000;                  // JoinRequest cadence until the first ClusterMap
   int poll_ms = 50;                          // the longest stop() waits to be noticed
@@ -123,15 +124,18 @@ struct ShardServerOptions {
 
 // Counters, readable from any thread (each field is read atomically, not all together).
 struct ShardCounters {
-  int64_t inserted = 0;           // transitions stored by this process
-  int64_t sampled = 0;            // transitions drawn for replies
-  int64_t malformed = 0;          // messages dropped as malformed, all sockets
-  int64_t requests_waiting = 0;   // sample requests queued now
-  int64_t insert_blocked_ms = 0;  // time the rate limiter held inserts back
-  int64_t replies_dropped = 0;    // replies ZeroMQ could not queue (learner gone or stalled)
-  int64_t size = 0;               // transitions held now
-  int64_t map_version = 0;        // of the last ClusterMap; 0 before joining
-  int64_t joins = 0;              // ClusterMaps taken (1 + re-joins)
+  int64_t inserted = 0;             // transitions stored by this process
+  int64_t sampled = 0;              // transitions drawn for replies
+  int64_t malformed = 0;            // messages dropped as malformed, all sockets
+  int64_t requests_waiting = 0;     // sample requests queued now
+  int64_t insert_blocked_ms = 0;    // time the rate limiter held inserts back
+  int64_t replies_dropped = 0;      // replies ZeroMQ could not queue (learner gone or stalled)
+  int64_t transitions_dropped = 0;  // transitions in those replies
+  int64_t size = 0;                 // transitions held now
+  int64_t capacity = 0;             // transitions the ring holds; 0 before joining
+  int64_t inserts_held = 0;         // 1 while the rate limiter holds inserts back
+  int64_t map_version = 0;          // of the last ClusterMap; 0 before joining
+  int64_t joins = 0;                // ClusterMaps taken (1 + re-joins)
 };
 
 // Builds the shard settings from a ClusterMap's config_toml; throws std::runtime_error if the
@@ -224,7 +228,7 @@ class ShardServer {
   std::atomic<bool> stop_{false};
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
-      size_{0}, map_version_pub_{0}, joins_{0};
+      size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0};
 };
 
 }  // namespace pamdp
