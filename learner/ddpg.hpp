@@ -56,6 +56,9 @@ struct UpdateStats {
   float target_mean = 0.0F;
   float critic_grad_norm = 0.0F;  // before clipping
   float actor_grad_norm = 0.0F;
+  // Continuous parameters of the batch's actor outputs at or past a bound of their range (a
+  // health check of the gradient bounding; W x B compares).
+  float params_at_bound_fraction = 0.0F;
 };
 
 class Ddpg {
@@ -95,6 +98,7 @@ class Ddpg {
   Adam<float> actor_adam_;
   Adam<float> critic_adam_;
   int64_t updates_ = 0;
+  int num_actions_ = 0;  // the discrete scores come first in the output; parameters follow
 
   // Scratch, sized for batch_size in the constructor.
   Eigen::MatrixXf critic_in_;  // (obs + width) x B
