@@ -37,6 +37,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.choice("env.body_at_reset", c.env.hfo.body_at_reset, body_at_reset_choices());
   v.integer("env.max_steps", c.env.hfo.max_steps, 1, 1000000);
   v.integer("env.untouched_limit", c.env.hfo.untouched_limit, 1, 1000000);
+  v.boolean("env.goalie", c.env.hfo.goalie);
 
   v.int_list("ddpg.hidden", c.ddpg.hidden, 1, 1 << 16);
   v.real("ddpg.actor_learning_rate", c.ddpg.actor_learning_rate, 0.0, 1.0);

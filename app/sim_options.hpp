@@ -16,6 +16,7 @@ struct SimOptions {
 
   void add_to(CLI::App& cmd) {
     cmd.add_flag("--no-noise", no_noise, "switch off movement, turn, kick and tackle noise");
+    cmd.add_flag("--goalie", config.goalie, "an NPC goalie defends the goal (1v1; 66 features instead of 58)");
     const std::map<std::string, pamdp::hfo::StartDistribution> starts(start_choices().begin(), start_choices().end());
     cmd.add_option("--start", config.start, "start distribution: paper (E1), dec2015 (E2), hfo (E3)")
         ->transform(CLI::CheckedTransformer(starts, CLI::ignore_case))

@@ -9,8 +9,8 @@
 
 namespace {
 
-void BM_SimStep(benchmark::State& state) {
-  pamdp::hfo::HfoEnv env;
+void run_sim_steps(benchmark::State& state, const pamdp::hfo::SoccerSimConfig& config) {
+  pamdp::hfo::HfoEnv env(config);
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
   env.reset(7, obs);
   // A cheap, deterministic action cycle that exercises dash, turn and kick; computing a
@@ -27,6 +27,16 @@ void BM_SimStep(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
+
+void BM_SimStep(benchmark::State& state) {
+  run_sim_steps(state, {});
+}
 BENCHMARK(BM_SimStep);
+
+// The same with the NPC goalie (1v1, 66 features): its decision, command and physics per step.
+void BM_SimStepGoalie(benchmark::State& state) {
+  run_sim_steps(state, {.goalie = true});
+}
+BENCHMARK(BM_SimStepGoalie);
 
 }  // namespace

@@ -34,9 +34,10 @@ TEST(CountingAllocator, SeesAllocations) {
 // Plays HFO episodes with a mix of every action. Everything the loop needs is built before
 // the counting scope opens; the first reset is outside too, so one-time lazy set-up (static
 // tables) is not blamed on the hot path.
-void expect_hfo_hot_path_allocation_free(bool noise) {
+void expect_hfo_hot_path_allocation_free(bool noise, bool goalie = false) {
   hfo::SoccerSimConfig config;
   config.noise = noise;
+  config.goalie = goalie;
   hfo::HfoEnv env(config);
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
   RandomPolicy random(env.action_space(), 3);
@@ -70,6 +71,10 @@ TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithNoise) {
 }
 TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithoutNoise) {
   expect_hfo_hot_path_allocation_free(false);
+}
+// 1v1: the NPC goalie's decision and catch run inside step().
+TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithGoalie) {
+  expect_hfo_hot_path_allocation_free(true, true);
 }
 
 TEST(ReachStopAllocations, StepAndResetAllocateNothing) {

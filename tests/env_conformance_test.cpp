@@ -36,15 +36,18 @@ void PrintTo(const EnvCase& c, std::ostream* os) {
   *os << c.name;
 }
 
-std::unique_ptr<Env> make_hfo(bool noise) {
+std::unique_ptr<Env> make_hfo(bool noise, bool goalie = false) {
   hfo::SoccerSimConfig config;
   config.noise = noise;
+  config.goalie = goalie;
   return std::make_unique<hfo::HfoEnv>(config);
 }
 
 const EnvCase kEnvCases[] = {
     {"HfoNoise", [] { return make_hfo(true); }, hfo::kNumAgentFeatures, 1.0F, 30},
     {"HfoNoNoise", [] { return make_hfo(false); }, hfo::kNumAgentFeatures, 1.0F, 30},
+    {"HfoGoalieNoise", [] { return make_hfo(true, true); }, hfo::feature_count(2), 1.0F, 30},
+    {"HfoGoalieNoNoise", [] { return make_hfo(false, true); }, hfo::feature_count(2), 1.0F, 30},
     {"ReachStop", [] { return std::make_unique<toy::ReachStopEnv>(); }, toy::ReachStopEnv::kObservationSize,
      toy::ReachStopEnv::kObservationBound, 200},
 };

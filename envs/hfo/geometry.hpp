@@ -138,4 +138,11 @@ inline constexpr double kMaxTacklePower = 100.0;
 inline constexpr double kMaxBackTacklePower = 0.0;
 inline constexpr double kTackleRandFactor = 2.0;
 
+// --- Goalie catch (rcssserver defaults; the reference gives none): catchable_area_l,
+// catchable_area_w, catch_probability, catch_ban_cycle. Player type 0 has no catch stretch. ---
+inline constexpr double kCatchableAreaLength = 1.2;
+inline constexpr double kCatchableAreaWidth = 1.0;
+inline constexpr double kCatchProbability = 1.0;
+inline constexpr int kCatchBanCycles = 5;
+
 }  // namespace pamdp::hfo

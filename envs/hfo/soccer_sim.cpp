@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "envs/hfo/goalie.hpp"
+
 namespace pamdp::hfo {
 namespace {
 
@@ -75,9 +77,9 @@ const char* status_name(int status) {
 }
 
 SoccerSim::SoccerSim(const SoccerSimConfig& config, uint64_t seed) : config_(config), rng_(seed) {
-  state_.players[0].pos = {0.0, 0.0};
-  state_.ball.pos = {10.0, 0.0};
-  state_.prev_ball = state_.ball.pos;
+  PlayerState agent;
+  agent.pos = {0.0, 0.0};
+  set_state(agent, BallState{{10.0, 0.0}, {0.0, 0.0}});
 }
 
 void SoccerSim::reset_episode() {
@@ -135,6 +137,17 @@ void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
   state_.prev_ball = ball.pos;
   state_.defense_hold = 0;
   state_.trainer_hold = 0;
+  state_.ball_caught = false;
+  if (config_.goalie) {
+    // HFO places the goalie at (52.5, 0) at every reset (reference §5.1).
+    PlayerState goalie;
+    goalie.pos = kGoalieStart;
+    goalie.body_deg = kGoalieStartBodyDeg;
+    goalie.team = Team::kDefense;
+    goalie.goalie = true;
+    state_.players[kGoalieIndex] = goalie;
+    state_.num_players = kGoalieIndex + 1;
+  }
   player_accel_.fill(Vec2{});
   ball_accel_ = {};
 }
@@ -151,7 +164,19 @@ Vec2 SoccerSim::noise_vector(double max_radius) {
 }
 
 bool SoccerSim::dash(double power, double dir_deg) {
-  PlayerState& p = state_.players[0];
+  return dash_player(0, power, dir_deg);
+}
+
+bool SoccerSim::turn(double dir_deg) {
+  return turn_player(0, dir_deg);
+}
+
+bool SoccerSim::kick(double power, double dir_deg) {
+  return kick_player(0, power, dir_deg);
+}
+
+bool SoccerSim::dash_player(int i, double power, double dir_deg) {
+  PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
   }
@@ -187,12 +212,12 @@ bool SoccerSim::dash(double power, double dir_deg) {
   p.stamina = std::max(0.0, p.stamina - spent);
   power = back ? -spent / 2.0 : spent;
   const double eff = std::fabs(p.effort * power * dash_dir_rate(dir) * kDashPowerRate);
-  player_accel_[0] += polar(eff, (p.body_deg + dir + (back ? 180.0 : 0.0)) * kDegToRad);
+  player_accel_[i] += polar(eff, (p.body_deg + dir + (back ? 180.0 : 0.0)) * kDegToRad);
   return true;
 }
 
-bool SoccerSim::turn(double dir_deg) {
-  PlayerState& p = state_.players[0];
+bool SoccerSim::turn_player(int i, double dir_deg) {
+  PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
   }
@@ -208,8 +233,8 @@ bool SoccerSim::turn(double dir_deg) {
   return true;
 }
 
-bool SoccerSim::kick(double power, double dir_deg) {
-  PlayerState& p = state_.players[0];
+bool SoccerSim::kick_player(int i, double power, double dir_deg) {
+  PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
   }
@@ -274,6 +299,44 @@ bool SoccerSim::tackle(double dir_deg) {
   }
   ball_accel_ += accel;
   return true;
+}
+
+bool SoccerSim::goalie_catch(int player, double dir_deg) {
+  PlayerState& p = state_.players[player];
+  if (!p.goalie || p.catch_ban > 0 || p.tackle_cycles > 0) {
+    return false;
+  }
+  // The server refuses a catch of a ball outside the goalie's penalty area.
+  const Vec2 b = state_.ball.pos;
+  if (b.x < kPenaltyBoxX || b.x > kPitchHalfLength || std::fabs(b.y) > kPenaltyBoxHalfWidth) {
+    return false;
+  }
+  p.catch_ban = kCatchBanCycles;
+  // Ball in the frame of the catch direction: the catchable area is the rectangle
+  // [0, l] x [-w/2, w/2] in front of the player's centre.
+  const double a = (p.body_deg + clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment)) * kDegToRad;
+  const Vec2 d = b - p.pos;
+  const double along = d.x * std::cos(a) + d.y * std::sin(a);
+  const double across = -d.x * std::sin(a) + d.y * std::cos(a);
+  if (along < 0.0 || along > kCatchableAreaLength || std::fabs(across) > 0.5 * kCatchableAreaWidth) {
+    return false;
+  }
+  // kCatchProbability is 1: no draw, so the noise stream does not depend on catches.
+  static_assert(kCatchProbability == 1.0);
+  state_.ball_caught = true;
+  state_.ball.vel = {};
+  ball_accel_ = {};
+  return true;
+}
+
+void SoccerSim::play_goalie() {
+  const GoalieCommand c = decide_goalie(state_, kGoalieIndex);
+  switch (c.kind) {
+    case GoalieCommand::Kind::kDash: dash_player(kGoalieIndex, c.power, c.dir_deg); break;
+    case GoalieCommand::Kind::kTurn: turn_player(kGoalieIndex, c.dir_deg); break;
+    case GoalieCommand::Kind::kCatch: goalie_catch(kGoalieIndex, c.dir_deg); break;
+    case GoalieCommand::Kind::kNone: break;
+  }
 }
 
 void SoccerSim::move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max,
@@ -429,11 +492,18 @@ void SoccerSim::update_stamina(PlayerState& p) {
 }
 
 int SoccerSim::step() {
+  if (config_.goalie) {
+    // The goalie sees the same state as the agent did and acts in the same cycle.
+    play_goalie();
+  }
   const int np = state_.num_players;
   for (int i = 0; i < np; ++i) {
     PlayerState& p = state_.players[i];
     if (p.tackle_cycles > 0) {
       --p.tackle_cycles;
+    }
+    if (p.catch_ban > 0) {
+      --p.catch_ban;
     }
     // Collision flags describe this cycle only.
     p.collided_ball = p.collided_player = p.collided_post = false;
@@ -483,7 +553,8 @@ int SoccerSim::referee_server() {
     }
   }
   state_.defense_hold = defense_near ? state_.defense_hold + 1 : 0;
-  if (goalie_near || state_.defense_hold >= 2) {
+  // A catch (2015) or the goalie within the kickable area (HEAD) ends it at once.
+  if (state_.ball_caught || goalie_near || state_.defense_hold >= 2) {
     return kCapturedByDefense;
   }
   if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {
@@ -520,7 +591,7 @@ int SoccerSim::referee_trainer() {
   if (ball.x < -0.1 || ball.x > kPitchHalfLength || std::fabs(ball.y) > kPitchHalfWidth) {
     return kOutOfBounds;
   }
-  if (held && defense_holder) {
+  if ((held && defense_holder) || state_.ball_caught) {
     return kCapturedByDefense;
   }
   if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {

@@ -3,8 +3,11 @@
 //
 // It owns no socket and no global state: construct as many as you like, one per thread.
 // Every call below is O(players) and allocates nothing. The agent the features describe is
-// players()[0]; more players (a goalie, teammates) have room in the state and take part in
-// physics and the referee, but only the agent has a command interface for now.
+// players()[0]. With SoccerSimConfig::goalie, players()[1] is the hand-coded NPC goalie of
+// envs/hfo/goalie.hpp: it decides from the state at the start of every step() and its command
+// goes through the same client and server handling as the agent's (dash, turn), plus the
+// goalie's catch. More players have room in the state and take part in physics, the referee
+// and the features, but have no command interface.
 //
 // Units: metres, metres per cycle, degrees for every angle in this API (the server works in
 // radians internally; commands and features use degrees).
@@ -56,7 +59,14 @@ struct SoccerSimConfig {
   Referee referee = Referee::kServer;
   int max_steps = 500;        // --frames-per-trial used by dqn-hfo
   int untouched_limit = 100;  // cycles the ball may stay untouched
+  bool goalie = false;        // an NPC goalie defends the goal (1v1): players()[1], 66 features
 };
+
+// Index of the NPC goalie in SoccerState::players when SoccerSimConfig::goalie is on.
+inline constexpr int kGoalieIndex = 1;
+// Where HFO puts the goalie at every reset (reference §5.1), facing the field.
+inline constexpr Vec2 kGoalieStart{kPitchHalfLength, 0.0};
+inline constexpr double kGoalieStartBodyDeg = 180.0;
 
 enum class Team : uint8_t { kOffense, kDefense };
 
@@ -69,6 +79,7 @@ struct PlayerState {
   double recovery = 1.0;
   double capacity = kStaminaCapacity;
   int tackle_cycles = 0;  // > 0 while frozen after a tackle
+  int catch_ban = 0;      // goalie: > 0 while a new catch is refused (catch_ban_cycle)
   bool collided_ball = false;
   bool collided_player = false;
   bool collided_post = false;
@@ -87,11 +98,12 @@ struct SoccerState {
   std::array<PlayerState, kMaxPlayers> players{};
   int num_players = 1;
   BallState ball;
-  int cycle = 0;         // cycles since the episode started
-  int untouched = 0;     // referee's untouched-ball counter
-  Vec2 prev_ball;        // ball position at the previous referee check
-  int defense_hold = 0;  // consecutive checks a defender was on the ball
-  int trainer_hold = 0;  // E1: consecutive cycles one player held the ball
+  int cycle = 0;             // cycles since the episode started
+  int untouched = 0;         // referee's untouched-ball counter
+  Vec2 prev_ball;            // ball position at the previous referee check
+  int defense_hold = 0;      // consecutive checks a defender was on the ball
+  int trainer_hold = 0;      // E1: consecutive cycles one player held the ball
+  bool ball_caught = false;  // the goalie caught the ball this episode (CAPTURED_BY_DEFENSE)
 };
 
 class SoccerSim {
@@ -102,7 +114,8 @@ class SoccerSim {
   void reset_episode();
   void reseed(uint64_t seed) { rng_.reseed(seed); }
 
-  // Replaces the state (tests, traces). Referee counters restart at this state.
+  // Replaces the state (tests, traces). Referee counters restart at this state; with a goalie
+  // configured, the goalie is put back at its start (kGoalieStart, at rest, full stamina).
   void set_state(const PlayerState& agent, const BallState& ball);
   [[nodiscard]] const SoccerState& state() const { return state_; }
   SoccerState& mutable_state() { return state_; }
@@ -117,6 +130,13 @@ class SoccerSim {
   bool tackle(double dir_deg);
   bool kick(double power, double dir_deg);
 
+  // The goalie's catch (rcssserver Player::goalieCatch with the defaults of geometry.hpp):
+  // refused unless `player` is a goalie, its catch ban is over and the ball is in the penalty
+  // area; sets the ban; succeeds if the ball centre lies in the catchable rectangle
+  // (kCatchableAreaLength along body + dir_deg, kCatchableAreaWidth across). A caught ball
+  // stops and the referee ends the episode with CAPTURED_BY_DEFENSE. Returns success.
+  bool goalie_catch(int player, double dir_deg);
+
   // Advances one server cycle (movement, collisions, referee, stamina) and returns the status.
   int step();
 
@@ -124,6 +144,10 @@ class SoccerSim {
   [[nodiscard]] bool agent_kickable() const;
 
  private:
+  bool dash_player(int i, double power, double dir_deg);
+  bool turn_player(int i, double dir_deg);
+  bool kick_player(int i, double power, double dir_deg);
+  void play_goalie();
   void move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max, double speed_max,
                    double rand, bool* hit_post);
   void collide_objects();

@@ -1,0 +1,286 @@
+// The NPC goalie of the embedded simulator (envs/hfo/goalie.hpp) and the 1v1 task: start
+// position (shared/hfo-reference.md §5.1), positioning, the catch and CAPTURED_BY_DEFENSE
+// (§5.2), the opponent features (§3.3), determinism, and the scripted offense's scoring rate
+// against it.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "envs/hfo/features.hpp"
+#include "envs/hfo/geometry.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/soccer_sim.hpp"
+#include "learner/evaluation.hpp"
+
+namespace pamdp::hfo {
+namespace {
+
+SoccerSimConfig goalie_config(bool noise = false) {
+  SoccerSimConfig c;
+  c.noise = noise;
+  c.goalie = true;
+  return c;
+}
+
+PlayerState agent_at(Vec2 pos, double body_deg = 0.0) {
+  PlayerState p;
+  p.pos = pos;
+  p.body_deg = body_deg;
+  return p;
+}
+
+// An action that changes nothing: dash with power 0.
+ParamAction no_op(std::array<float, param::kCount>& params) {
+  params.fill(0.0F);
+  return {kDash, params};
+}
+
+// Signed area test: p lies inside the triangle (a, b, c), either orientation.
+bool inside_triangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
+  const auto side = [](Vec2 o, Vec2 u, Vec2 q) { return (u.x - o.x) * (q.y - o.y) - (u.y - o.y) * (q.x - o.x); };
+  const double d1 = side(a, b, p);
+  const double d2 = side(b, c, p);
+  const double d3 = side(c, a, p);
+  const bool has_neg = d1 < 0 || d2 < 0 || d3 < 0;
+  const bool has_pos = d1 > 0 || d2 > 0 || d3 > 0;
+  return !(has_neg && has_pos);
+}
+
+TEST(HfoGoalie, OffByDefaultSo1v0Keeps58Features) {
+  HfoEnv env;
+  EXPECT_EQ(env.observation_size(), kNumAgentFeatures);
+  EXPECT_EQ(env.sim().state().num_players, 1);
+}
+
+TEST(HfoGoalie, StartsAtGoalCentreEveryEpisode) {
+  HfoEnv env(goalie_config(true));
+  ASSERT_EQ(env.observation_size(), 66);
+  std::vector<float> obs(66);
+  std::array<float, param::kCount> params{};
+  for (int ep = 0; ep < 3; ++ep) {
+    env.reset(static_cast<uint64_t>(ep) + 5, obs);
+    const PlayerState& g = env.sim().state().players[kGoalieIndex];
+    EXPECT_EQ(env.sim().state().num_players, 2);
+    EXPECT_EQ(g.pos.x, 52.5);
+    EXPECT_EQ(g.pos.y, 0.0);
+    EXPECT_TRUE(g.vel.is_zero());
+    EXPECT_EQ(g.body_deg, 180.0);
+    EXPECT_EQ(g.team, Team::kDefense);
+    EXPECT_TRUE(g.goalie);
+    EXPECT_EQ(g.stamina, kStaminaMax);
+    for (int k = 0; k < 30; ++k) {
+      if (env.step(no_op(params), obs).terminal()) {
+        break;
+      }
+    }
+  }
+}
+
+// Ball still at (30, 15), the goalie put off the line at (50, -5): it ends between the ball and
+// the goal mouth, out from the goal line, facing the ball, and stays there.
+TEST(HfoGoalie, MovesBetweenBallAndGoal) {
+  SoccerSim sim(goalie_config(), 1);
+  sim.set_state(agent_at({5.0, -20.0}), BallState{{30.0, 15.0}, {0.0, 0.0}});
+  PlayerState& g = sim.mutable_state().players[kGoalieIndex];
+  g.pos = {50.0, -5.0};
+  const Vec2 ball = sim.state().ball.pos;
+  const Vec2 post_top{kPitchHalfLength, -kGoalHalfWidth};
+  const Vec2 post_bottom{kPitchHalfLength, kGoalHalfWidth};
+  ASSERT_FALSE(inside_triangle(g.pos, ball, post_top, post_bottom));
+  const auto distance_to_centre_line = [&](Vec2 p) {
+    const Vec2 u = (Vec2{kPitchHalfLength, 0.0} - ball) * (1.0 / (Vec2{kPitchHalfLength, 0.0} - ball).r());
+    const Vec2 d = p - ball;
+    return std::fabs(d.x * u.y - d.y * u.x);
+  };
+  const double start_off_line = distance_to_centre_line(g.pos);
+  for (int k = 0; k < 40; ++k) {
+    ASSERT_EQ(sim.step(), kInGame) << "cycle " << k;
+  }
+  const PlayerState& after = sim.state().players[kGoalieIndex];
+  EXPECT_TRUE(inside_triangle(after.pos, ball, post_top, post_bottom))
+      << "goalie at (" << after.pos.x << ", " << after.pos.y << ")";
+  EXPECT_LT(distance_to_centre_line(after.pos), 0.25 * start_off_line);
+  EXPECT_LT(after.pos.x, 45.0) << "it comes out toward a ball 25 m away";
+  EXPECT_LT(after.vel.r(), 0.05) << "and stops there";
+  const Vec2 to_ball = ball - after.pos;
+  const double bearing = wrap_deg(std::atan2(to_ball.y, to_ball.x) * kRadToDeg - after.body_deg);
+  EXPECT_LE(std::fabs(bearing), 20.0) << "facing the ball";
+}
+
+// The catchable area: 1.2 m long, 1.0 m wide, in the catch direction; only in the penalty
+// area; a failed attempt bans the next one for 5 cycles; only goalies catch.
+TEST(HfoGoalie, CatchRules) {
+  SoccerSim sim(goalie_config(), 1);
+  const auto place = [&](Vec2 ball) {
+    sim.set_state(agent_at({20.0, 20.0}), BallState{ball, {0.0, 0.0}});
+    sim.mutable_state().players[kGoalieIndex].body_deg = 180.0;  // facing -x
+  };
+  place({51.4, 0.0});  // 1.1 m straight ahead
+  EXPECT_FALSE(sim.goalie_catch(0, 0.0)) << "the agent is no goalie";
+  EXPECT_TRUE(sim.goalie_catch(kGoalieIndex, 0.0));
+  EXPECT_TRUE(sim.state().ball_caught);
+  EXPECT_TRUE(sim.state().ball.vel.is_zero());
+
+  place({51.25, 0.0});  // 1.25 m ahead: beyond the catchable length
+  EXPECT_FALSE(sim.goalie_catch(kGoalieIndex, 0.0));
+  EXPECT_FALSE(sim.state().ball_caught);
+  sim.mutable_state().ball.pos = {51.9, 0.0};  // 0.6 m ahead, but the failed attempt's ban holds
+  for (int k = 0; k < kCatchBanCycles; ++k) {
+    EXPECT_FALSE(sim.goalie_catch(kGoalieIndex, 0.0)) << "cycle " << k;
+    sim.mutable_state().players[kGoalieIndex].catch_ban -= 1;  // what step() does
+  }
+  EXPECT_TRUE(sim.goalie_catch(kGoalieIndex, 0.0));
+
+  place({51.9, 0.45});  // 0.6 ahead, 0.45 to the side: inside the 1.0 m width
+  EXPECT_TRUE(sim.goalie_catch(kGoalieIndex, 0.0));
+  place({51.9, 0.55});  // 0.55 to the side: outside
+  EXPECT_FALSE(sim.goalie_catch(kGoalieIndex, 0.0));
+  place({51.9, 0.55});  // the same ball, caught by turning the catch toward it
+  sim.mutable_state().players[kGoalieIndex].catch_ban = 0;
+  EXPECT_TRUE(sim.goalie_catch(kGoalieIndex, wrap_deg(std::atan2(0.55, -0.6) * kRadToDeg - 180.0)));
+  place({51.4, 0.0});  // behind the catch direction
+  EXPECT_FALSE(sim.goalie_catch(kGoalieIndex, 180.0));
+
+  sim.set_state(agent_at({20.0, 20.0}), BallState{{35.0, 0.0}, {0.0, 0.0}});
+  sim.mutable_state().players[kGoalieIndex].pos = {35.8, 0.0};  // ball 0.8 m away, outside the box
+  EXPECT_FALSE(sim.goalie_catch(kGoalieIndex, 180.0 - sim.state().players[kGoalieIndex].body_deg));
+}
+
+// The ball 1.15 m in front of the goalie (outside the 1.085 m kickable area, inside the 1.2 m
+// catchable length): it catches in the first cycle and the episode ends CAPTURED_BY_DEFENSE
+// with reward 0 (no shaping on the first or the terminal transition, no goal).
+TEST(HfoGoalie, CatchEndsEpisodeCapturedByDefense) {
+  HfoEnv env(goalie_config());
+  std::vector<float> obs(66);
+  std::array<float, param::kCount> params{};
+  env.set_state(agent_at({30.0, 10.0}), BallState{{52.5 - 1.15, 0.0}, {0.0, 0.0}}, obs);
+  const StepResult r = env.step(no_op(params), obs);
+  EXPECT_EQ(r.status, kCapturedByDefense);
+  EXPECT_EQ(r.reward, 0.0F);
+  EXPECT_TRUE(env.sim().state().ball_caught);
+  EXPECT_EQ(env.status_name(r.status), "CAPTURED_BY_DEFENSE");
+}
+
+// A slow ball rolled straight at the goalie from 10 m: it never reaches the goal.
+TEST(HfoGoalie, SlowShotStraightAtItIsCaptured) {
+  for (const bool noise : {false, true}) {
+    HfoEnv env(goalie_config(noise));
+    std::vector<float> obs(66);
+    std::array<float, param::kCount> params{};
+    env.reset(3, obs);  // seeds the noise stream
+    env.set_state(agent_at({30.0, 10.0}), BallState{{42.5, 0.0}, {1.0, 0.0}}, obs);
+    StepResult r;
+    int steps = 0;
+    do {
+      r = env.step(no_op(params), obs);
+      ++steps;
+    } while (!r.terminal() && steps < 100);
+    EXPECT_EQ(r.status, kCapturedByDefense) << "noise " << noise;
+    EXPECT_EQ(r.reward, 0.0F);
+    EXPECT_LE(steps, 15);
+  }
+}
+
+// Reference §3.3 for a hand-placed state: agent at (40, 0) facing +x at rest, goalie at
+// (50, 5) facing -x moving (0.3, 0.4).
+TEST(HfoGoalie, OpponentFeaturesOfHandPlacedState) {
+  SoccerSim sim(goalie_config(), 1);
+  sim.set_state(agent_at({40.0, 0.0}), BallState{{45.0, 0.0}, {0.0, 0.0}});
+  PlayerState& g = sim.mutable_state().players[kGoalieIndex];
+  g.pos = {50.0, 5.0};
+  g.body_deg = 180.0;
+  g.vel = {0.3, 0.4};
+  std::vector<float> f(static_cast<size_t>(feature_count(2)));
+  ASSERT_EQ(f.size(), 66U);
+  write_features(sim.state(), f);
+  const double d = std::sqrt(125.0);
+  const double R = std::sqrt(52.5 * 52.5 + 34.0 * 34.0);
+  constexpr double kTol = 1e-6;
+  EXPECT_NEAR(f[58], 5.0 / d, kTol);                 // sin of the bearing (to the right)
+  EXPECT_NEAR(f[59], 10.0 / d, kTol);                // cos
+  EXPECT_NEAR(f[60], 1.0 - 2.0 * d / R, kTol);       // proximity, 0.642509
+  EXPECT_NEAR(f[61], 0.0, kTol);                     // sin of its body angle 180
+  EXPECT_NEAR(f[62], -1.0, kTol);                    // cos
+  EXPECT_NEAR(f[63], 2.0 * 0.5 / 0.75 - 1.0, kTol);  // speed 0.5 with max 0.75
+  EXPECT_NEAR(f[64], 0.8, kTol);                     // sin of its velocity direction
+  EXPECT_NEAR(f[65], 0.6, kTol);                     // cos
+  for (float v : f) {
+    EXPECT_LE(std::fabs(v), 1.0F);
+  }
+  // The agent's own 58 features do not depend on the goalie.
+  SoccerSim alone({.noise = false}, 1);
+  alone.set_state(agent_at({40.0, 0.0}), BallState{{45.0, 0.0}, {0.0, 0.0}});
+  std::vector<float> f58(kNumAgentFeatures);
+  write_features(alone.state(), f58);
+  for (int i = 0; i < kNumAgentFeatures; ++i) {
+    EXPECT_EQ(f[static_cast<size_t>(i)], f58[static_cast<size_t>(i)]) << "feature " << i;
+  }
+  // Only players with x > 0 count (§3.3): a goalie behind the halfway line is a zero block.
+  g.pos = {-1.0, 0.0};
+  write_features(sim.state(), f);
+  for (int i = 58; i < 66; ++i) {
+    EXPECT_EQ(f[static_cast<size_t>(i)], 0.0F) << "feature " << i;
+  }
+}
+
+// Same seed, same episodes, bit for bit (the goalie draws nothing, its movement noise comes
+// from the env's stream).
+TEST(HfoGoalie, DeterministicWithSeed) {
+  const auto play = [](uint64_t seed) {
+    HfoEnv env(goalie_config(true));
+    ScriptedOffense policy;
+    std::vector<float> obs(66);
+    std::vector<uint32_t> trace;
+    for (int ep = 0; ep < 10; ++ep) {
+      if (ep == 0) {
+        env.reset(seed, obs);
+      } else {
+        env.reset(obs);
+      }
+      StepResult r;
+      do {
+        r = env.step(policy.act(obs), obs);
+        for (float v : obs) {
+          trace.push_back(std::bit_cast<uint32_t>(v));
+        }
+        trace.push_back(static_cast<uint32_t>(r.status));
+        trace.push_back(std::bit_cast<uint32_t>(r.reward));
+      } while (!r.terminal());
+    }
+    return trace;
+  };
+  const auto a = play(11);
+  EXPECT_EQ(a, play(11));
+  EXPECT_NE(a, play(12));
+}
+
+// The scripted offense against the goalie scores clearly less than on the empty goal, as
+// agent2d's offense does in the real HFO (.993 empty, .825 against agent2d's goalie), but is
+// not shut out. Measured over 1,000 episodes: about .998 empty and .84 against the goalie
+// (docs/results.md); with 300 episodes the standard error of the goalie rate is about .02, so
+// the bounds below (a drop of at least .10, a rate of at least .60) leave 3 and 10 standard
+// errors of room. The seed is fixed, so the test is deterministic anyway.
+TEST(HfoGoalie, ScriptedOffenseScoresClearlyLessAgainstGoalie) {
+  constexpr int kEpisodes = 300;
+  constexpr uint64_t kSeed = 20160101;
+  SoccerSimConfig empty;
+  empty.noise = true;
+  HfoEnv env_empty(empty);
+  HfoEnv env_goalie(goalie_config(true));
+  ScriptedOffense policy;
+  const EvalResult r_empty = evaluate(env_empty, policy, kEpisodes, kSeed);
+  const EvalResult r_goalie = evaluate(env_goalie, policy, kEpisodes, kSeed);
+  EXPECT_GE(r_empty.goal_rate, 0.95) << to_json(r_empty);
+  EXPECT_LE(r_goalie.goal_rate, r_empty.goal_rate - 0.10) << to_json(r_goalie);
+  EXPECT_GE(r_goalie.goal_rate, 0.60) << to_json(r_goalie);
+  EXPECT_GE(r_goalie.outcomes.at("CAPTURED_BY_DEFENSE"), kEpisodes / 20) << to_json(r_goalie);
+}
+
+}  // namespace
+}  // namespace pamdp::hfo
