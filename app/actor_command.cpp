@@ -17,6 +17,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
 
@@ -38,6 +39,8 @@ struct ActorCliOptions {
   std::string curve_keys;
   double join_timeout_s = 0.0;
   double progress_every_s = 5.0;
+  std::string metrics_bind = "127.0.0.1";
+  int metrics_port = 0;
 };
 
 std::string default_name() {
@@ -62,6 +65,11 @@ void run_actor(const ActorCliOptions& o) {
     curve = net::load_curve_keyring(o.curve_keys, /*need_server=*/false).client;
     link_config.curve = curve;
   }
+  // Served from the start: the URL goes to the learner with the JoinRequest. The counters are
+  // declared first, so that they outlive the endpoint's last scrape.
+  ActorCounters counters;
+  MetricsEndpoint endpoint("actor", link_config.name, o.metrics_bind, o.metrics_port, "");
+  link_config.metrics_url = endpoint.url();
   LearnerLink link(ctx, link_config);
   const std::optional<ClusterInfo> map = link.join(g_stop);
   if (!map) {
@@ -89,8 +97,11 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.seed = o.seed >= 0 ? static_cast<uint64_t>(o.seed) : config.seed;
   loop_config.curve = curve;
 
-  ActorCounters counters;
+  ActorMetrics actor_metrics(endpoint.registry(), counters, *envs.front());
   ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);
+  loop.on_episode = [&actor_metrics](int status, double ret, int steps) {
+    actor_metrics.on_episode(status, ret, steps);
+  };
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   int64_t last_steps = 0;
@@ -146,6 +157,12 @@ void register_actor(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--progress-every", o->progress_every_s, "seconds between progress lines")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--metrics-bind", o->metrics_bind,
+                  "address of this machine to serve /metrics on (0.0.0.0: every interface)")
+      ->capture_default_str();
+  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics (0: any free port, logged)")
+      ->check(CLI::Range(0, 65535))
       ->capture_default_str();
   cmd->add_option("--log-level", "trace, debug, info, warn, error or off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))

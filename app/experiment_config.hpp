@@ -44,6 +44,14 @@ struct ClusterConfig {
   std::string curve_keys_dir = "keys";  // written by pamdp keygen
 };
 
+// The /metrics endpoint of `pamdp learner` and `pamdp train` (actors and shards take
+// --metrics-bind / --metrics-port, since many run on one machine). Port 0 = any free port; the URL
+// is logged and written to the run directory's metrics_urls.txt.
+struct MetricsConfig {
+  std::string bind = "127.0.0.1";  // an address of this machine; 0.0.0.0 for every interface
+  int port = 0;
+};
+
 struct TrainLoopConfig {
   int64_t max_updates = 3000000;
   int64_t max_episodes = 0;  // 0 = no limit
@@ -68,6 +76,7 @@ struct ExperimentConfig {
   ReplayConfig replay;
   TrainLoopConfig train;
   ClusterConfig cluster;
+  MetricsConfig metrics;
 };
 
 // Names of the enum-valued settings, shared by the config file and the command-line options.

@@ -16,6 +16,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/role_metrics.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
@@ -43,6 +44,8 @@ struct LearnerCliOptions {
   std::string run_dir;
   std::string resume;
   bool quiet = false;
+  std::string metrics_bind;  // overrides metrics.bind when set
+  int metrics_port = -1;     // overrides metrics.port when >= 0
 };
 
 void run_learner(const LearnerCliOptions& o) {
@@ -99,6 +102,15 @@ void run_learner(const LearnerCliOptions& o) {
   sc.peer_timeout_ms = c.cluster.peer_timeout_ms;
   sc.max_updates = c.train.max_updates;
   sc.max_seconds = c.train.max_seconds;
+  if (!o.metrics_bind.empty()) {
+    c.metrics.bind = o.metrics_bind;
+  }
+  if (o.metrics_port >= 0) {
+    c.metrics.port = o.metrics_port;
+  }
+  MetricsEndpoint endpoint("learner", "learner", c.metrics.bind, c.metrics.port, c.cluster.advertise_host);
+  LearnerMetrics learner_metrics(endpoint.registry(), *env, exploration);
+  sc.metrics_url = endpoint.url();
 
   net::Context ctx;
   std::unique_ptr<net::CurveAuthenticator> auth;  // before the server: outlives its sockets
@@ -148,7 +160,11 @@ void run_learner(const LearnerCliOptions& o) {
     last_checkpoint = elapsed();
   };
 
+  server.on_metrics_urls = [&](const std::vector<std::string>& urls) {
+    write_metrics_urls((fs::path(run_dir) / "metrics_urls.txt").string(), urls);
+  };
   server.on_episode = [&](const EpisodeSummary& e) {
+    learner_metrics.on_episode(e);
     ++episode_count;
     const bool success = e.status == env->success_status();
     recent.add(e.ret, e.steps, success);
@@ -156,6 +172,7 @@ void run_learner(const LearnerCliOptions& o) {
              << e.steps << ',' << env->status_name(e.status) << '\n';
   };
   server.on_update = [&](const UpdateStats& s) {
+    learner_metrics.on_update(s, ddpg.updates());
     last_stats = s;
     const int64_t every = c.train.eval_every_updates;
     if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
@@ -165,6 +182,7 @@ void run_learner(const LearnerCliOptions& o) {
     }
   };
   server.on_tick = [&](const LearnerCounters& k) {
+    learner_metrics.on_tick(k, ddpg.updates(), server.metrics_urls().size());
     const double now = elapsed();
     const double dt = std::max(1e-9, now - last_tick);
     const double ups = static_cast<double>(ddpg.updates() - last_updates) / dt;
@@ -227,6 +245,9 @@ void register_learner(CLI::App& app) {
   cmd->add_option("--run-dir", o->run_dir, "where config, metrics and checkpoints go");
   cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->add_option("--metrics-bind", o->metrics_bind, "address to serve /metrics on (overrides metrics.bind)");
+  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics, 0 = any free port (overrides metrics.port)")
+      ->check(CLI::Range(0, 65535));
   cmd->callback([o] { run_learner(*o); });
 }
 

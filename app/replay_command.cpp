@@ -11,6 +11,7 @@
 
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
+#include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
 
@@ -38,6 +39,8 @@ struct ReplayCliOptions {
   std::string snapshot;
   std::string name;
   std::string curve_keys;
+  std::string metrics_bind = "127.0.0.1";
+  int metrics_port = 0;
 };
 
 std::string default_name() {
@@ -65,9 +68,19 @@ void run_replay(const ReplayCliOptions& o) {
     options.curve_client = keys.client;
     auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
   }
+  auto endpoint =
+      std::make_unique<MetricsEndpoint>("replay", options.name, o.metrics_bind, o.metrics_port, o.advertise_host);
+  options.metrics_url = endpoint->url();
   ShardServer server(ctx, options, shard_config_from_toml);
-  std::printf("pamdp replay: inserts at %s, samples at %s; joining the learner at %s\n",
-              server.insert_endpoint().c_str(), server.sample_endpoint().c_str(), o.join.c_str());
+  register_shard_metrics(endpoint->registry(), server);
+  // The endpoint's scrapes read the server: stop serving them before the server goes.
+  const struct StopMetricsFirst {
+    std::unique_ptr<MetricsEndpoint>& e;
+    ~StopMetricsFirst() { e.reset(); }
+  } stop_metrics_first{endpoint};
+  std::printf("pamdp replay: inserts at %s, samples at %s; joining the learner at %s; metrics at %s\n",
+              server.insert_endpoint().c_str(), server.sample_endpoint().c_str(), o.join.c_str(),
+              options.metrics_url.c_str());
   std::fflush(stdout);
 
   g_server.store(&server);
@@ -140,6 +153,12 @@ void register_replay(CLI::App& app) {
   cmd->add_option("--curve-keys", o->curve_keys,
                   "directory written by pamdp keygen: encrypt and authenticate every socket with CURVE "
                   "(the learner must run with cluster.curve = true)");
+  cmd->add_option("--metrics-bind", o->metrics_bind,
+                  "address of this machine to serve /metrics on (0.0.0.0: every interface)")
+      ->capture_default_str();
+  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics (0: any free port, logged)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
   // Lets the global --log-level come after the subcommand name too.
   cmd->fallthrough();
   cmd->callback([o] { run_replay(*o); });

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/role_metrics.hpp"
 #include "app/run_support.hpp"
 #include "app/trainer.hpp"
 
@@ -31,6 +33,8 @@ struct TrainCliOptions {
   std::string resume;
   bool quiet = false;
   bool json = false;
+  std::string metrics_bind;  // overrides metrics.bind when set
+  int metrics_port = -1;     // overrides metrics.port when >= 0
 };
 
 void run_train(const TrainCliOptions& o) {
@@ -64,6 +68,17 @@ void run_train(const TrainCliOptions& o) {
   }
   opts.quiet = o.quiet;
   opts.stop = &g_stop;
+  if (!o.metrics_bind.empty()) {
+    config.metrics.bind = o.metrics_bind;
+  }
+  if (o.metrics_port >= 0) {
+    config.metrics.port = o.metrics_port;
+  }
+  MetricsEndpoint endpoint("train", opts.run_dir, config.metrics.bind, config.metrics.port, "");
+  TrainMetrics train_metrics(endpoint.registry(), *make_env(config.env), config.replay.capacity);
+  opts.metrics = &train_metrics;
+  fs::create_directories(opts.run_dir);
+  write_metrics_urls((fs::path(opts.run_dir) / "metrics_urls.txt").string(), {endpoint.url()});
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   if (!o.quiet) {
@@ -101,6 +116,9 @@ void register_train(CLI::App& app) {
   cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
   cmd->add_flag("--quiet", o->quiet, "no progress lines");
   cmd->add_flag("--json", o->json, "print one JSON summary object as the last line");
+  cmd->add_option("--metrics-bind", o->metrics_bind, "address to serve /metrics on (overrides metrics.bind)");
+  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics, 0 = any free port (overrides metrics.port)")
+      ->check(CLI::Range(0, 65535));
   cmd->callback([o] { run_train(*o); });
 }
 

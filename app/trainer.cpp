@@ -12,6 +12,7 @@
 #include "actor/exploration.hpp"
 #include "app/actor_policy.hpp"
 #include "app/env_factory.hpp"
+#include "app/role_metrics.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "learner/checkpoint.hpp"
@@ -282,6 +283,9 @@ TrainSummary Trainer::run() {
       ep_return += sr.reward;
       ++steps;
       ++env_steps_;
+      if (o_.metrics != nullptr) {
+        o_.metrics->on_step(eps);
+      }
       std::swap(obs_, next_obs_);
 
       update_credit_ += c_.train.updates_per_step;
@@ -299,6 +303,9 @@ TrainSummary Trainer::run() {
             Eigen::Map<const Eigen::VectorXf>(batch_.mc_returns.data(), B),
         };
         last_stats_ = ddpg_.update(view);
+        if (o_.metrics != nullptr) {
+          o_.metrics->on_update(last_stats_, ddpg_.updates(), B);
+        }
         update_credit_ -= 1.0;
       }
       if (replay_.size() < c_.replay.warmup) {
@@ -311,6 +318,9 @@ TrainSummary Trainer::run() {
     ++episodes_;
     const bool success = sr.status == env_->success_status();
     recent_.add(ep_return, steps, success);
+    if (o_.metrics != nullptr) {
+      o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()));
+    }
     episodes_csv_ << episodes_ << ',' << elapsed() << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << ep_return
                   << ',' << steps << ',' << env_->status_name(sr.status) << '\n';
     if (ddpg_.updates() >= next_eval_) {

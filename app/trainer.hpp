@@ -28,11 +28,14 @@ struct TrainSummary {
   EvalResult final_eval;  // greedy evaluation at the end (train.eval_episodes episodes)
 };
 
+class TrainMetrics;  // app/role_metrics.hpp
+
 struct TrainOptions {
   std::string run_dir;
   bool resume = false;                      // continue from run_dir/checkpoint.ckpt
   bool quiet = false;                       // no progress lines on stdout
   const std::atomic<bool>* stop = nullptr;  // set by a signal handler to stop at the next episode end
+  TrainMetrics* metrics = nullptr;          // live metrics (/metrics); may be null
 };
 
 TrainSummary train(const ExperimentConfig& config, const TrainOptions& options);
