@@ -14,5 +14,6 @@ void register_train(CLI::App& app);
 void register_replay(CLI::App& app);
 void register_learner(CLI::App& app);
 void register_keygen(CLI::App& app);
+void register_monitor(CLI::App& app);
 
 }  // namespace pamdp::app

@@ -27,6 +27,7 @@ int run(int argc, char** argv) {
   pamdp::app::register_replay(app);
   pamdp::app::register_learner(app);
   pamdp::app::register_keygen(app);
+  pamdp::app::register_monitor(app);
 
   std::string valid;
   bool known = false;

@@ -1,6 +1,7 @@
 #include "core/metrics_http.hpp"
 
 #include <httplib.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -53,6 +54,12 @@ MetricsHttpServer::MetricsHttpServer(const Registry& registry, const std::string
   // Two workers: a scrape never waits behind another, and an idle process keeps few threads.
   s.new_task_queue = [] { return new httplib::ThreadPool(2); };
   s.set_keep_alive_max_count(1);
+  // cpp-httplib's default sets SO_REUSEPORT, which lets a second process bind a port in use and
+  // share its scrapes; SO_REUSEADDR alone makes that an error and still allows quick restarts.
+  s.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   s.set_read_timeout(std::chrono::seconds(5));
   s.set_write_timeout(std::chrono::seconds(5));
   s.Get("/metrics", [&registry](const httplib::Request&, httplib::Response& res) {

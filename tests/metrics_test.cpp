@@ -1,0 +1,157 @@
+// The metrics registry (core/metrics.hpp) and its HTTP endpoint (core/metrics_http.hpp): the text
+// format, misuse, updates that allocate nothing, and a real scrape over loopback.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/metrics.hpp"
+#include "core/metrics_http.hpp"
+#include "counting_new.hpp"
+
+namespace pamdp::metrics {
+namespace {
+
+TEST(Metrics, RendersTheTextFormat) {
+  Registry r;
+  Counter& c = r.counter("pamdp_things_total", "Things done");
+  Counter& goal = r.counter("pamdp_outcomes_total", "By outcome", {{"outcome", "GOAL"}});
+  Counter& out = r.counter("pamdp_outcomes_total", "By outcome", {{"outcome", "OUT\"OF\\BOUNDS\n"}});
+  Gauge& g = r.gauge("pamdp_fill_ratio", "Fill\nratio");
+  c.add(3);
+  c.add();
+  goal.add(2);
+  out.set(7);
+  g.set(0.25);
+  const std::string text = r.render();
+  EXPECT_EQ(text,
+            "# HELP pamdp_things_total Things done\n"
+            "# TYPE pamdp_things_total counter\n"
+            "pamdp_things_total 4\n"
+            "# HELP pamdp_outcomes_total By outcome\n"
+            "# TYPE pamdp_outcomes_total counter\n"
+            "pamdp_outcomes_total{outcome=\"GOAL\"} 2\n"
+            "pamdp_outcomes_total{outcome=\"OUT\\\"OF\\\\BOUNDS\\n\"} 7\n"
+            "# HELP pamdp_fill_ratio Fill\\nratio\n"
+            "# TYPE pamdp_fill_ratio gauge\n"
+            "pamdp_fill_ratio 0.25\n");
+  int bad = -1;
+  const std::vector<Sample> samples = parse_exposition(text, &bad);
+  EXPECT_EQ(bad, 0);
+  ASSERT_EQ(samples.size(), 4U);
+  EXPECT_EQ(samples[0].name, "pamdp_things_total");
+  EXPECT_EQ(samples[0].value, 4.0);
+  ASSERT_NE(samples[2].label("outcome"), nullptr);
+  EXPECT_EQ(*samples[2].label("outcome"), "OUT\"OF\\BOUNDS\n");
+  EXPECT_EQ(samples[3].value, 0.25);
+}
+
+TEST(Metrics, SpecialValuesAndForeignText) {
+  EXPECT_EQ(format_value(NAN), "NaN");
+  EXPECT_EQ(format_value(INFINITY), "+Inf");
+  EXPECT_EQ(format_value(-INFINITY), "-Inf");
+  EXPECT_EQ(format_value(12.0), "12");
+  EXPECT_EQ(format_value(1795267400.5), "1795267400.5");
+  int bad = 0;
+  const auto s = parse_exposition(
+      "# a comment\n\nup 1 1700000000000\nx{a=\"1\",b=\"2\",} +Inf\nnot valid here\ny{a=\"unterminated} 1\n", &bad);
+  ASSERT_EQ(s.size(), 2U);
+  EXPECT_EQ(s[0].name, "up");
+  EXPECT_EQ(s[0].value, 1.0);
+  EXPECT_EQ(s[1].labels.size(), 2U);
+  EXPECT_TRUE(std::isinf(s[1].value));
+  EXPECT_EQ(bad, 2);
+}
+
+TEST(Metrics, MisuseIsRefused) {
+  Registry r;
+  r.counter("a_total", "x");
+  EXPECT_THROW(r.counter("a_total", "x"), std::invalid_argument);  // same name and labels twice
+  EXPECT_THROW(r.gauge("a_total", "x"), std::invalid_argument);    // a counter and a gauge
+  EXPECT_THROW(r.counter("no_suffix", "x"), std::invalid_argument);
+  EXPECT_THROW(r.gauge("1bad", "x"), std::invalid_argument);
+  EXPECT_THROW(r.gauge("ok", "x", {{"bad-label", "v"}}), std::invalid_argument);
+  EXPECT_NO_THROW(r.counter("a_total", "x", {{"k", "v"}}));
+}
+
+TEST(Metrics, CollectHooksRunBeforeRendering) {
+  Registry r;
+  Gauge& g = r.gauge("copied", "a value kept elsewhere");
+  int source = 5;
+  r.on_collect([&] { g.set(source); });
+  source = 9;
+  EXPECT_NE(r.render().find("copied 9\n"), std::string::npos);
+}
+
+TEST(Metrics, UpdatesAllocateNothing) {
+  Registry r;
+  Counter& c = r.counter("c_total", "c", {{"k", "v"}});
+  Gauge& g = r.gauge("g", "g");
+  testing::alloc::CountAllocations count;
+  for (int i = 0; i < 1000; ++i) {
+    c.add(1);
+    g.set(i);
+    g.add(0.5);
+  }
+  EXPECT_EQ(count.count(), 0);
+  EXPECT_EQ(c.value(), 1000);
+}
+
+TEST(MetricsHttp, ServesAndFetchesOverLoopback) {
+  Registry r;
+  Counter& c = r.counter("pamdp_scrapes_seen_total", "x");
+  MetricsHttpServer server(r, "127.0.0.1", 0);
+  ASSERT_GT(server.port(), 0);
+  EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(server.port()) + "/metrics");
+  // Updates from another thread while scrapes render.
+  std::thread writer([&] {
+    for (int i = 0; i < 100000; ++i) {
+      c.add(1);
+    }
+  });
+  std::string error;
+  for (int i = 0; i < 3; ++i) {
+    const auto body = http_get(server.url(), 2000, &error);
+    ASSERT_TRUE(body.has_value()) << error;
+    const auto samples = parse_exposition(*body);
+    ASSERT_EQ(samples.size(), 1U);
+    EXPECT_EQ(samples[0].name, "pamdp_scrapes_seen_total");
+  }
+  writer.join();
+  const auto body = http_get(server.url(), 2000, &error);
+  ASSERT_TRUE(body.has_value()) << error;
+  EXPECT_NE(body->find("pamdp_scrapes_seen_total 100000\n"), std::string::npos);
+  EXPECT_FALSE(http_get("http://127.0.0.1:" + std::to_string(server.port()) + "/nothing", 2000, &error));
+  EXPECT_NE(error.find("404"), std::string::npos) << error;
+}
+
+TEST(MetricsHttp, PortInUseIsAnErrorNamingTheFix) {
+  Registry r;
+  MetricsHttpServer first(r, "127.0.0.1", 0);
+  try {
+    MetricsHttpServer second(r, "127.0.0.1", first.port());
+    FAIL() << "bound a port in use";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--metrics-port"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MetricsHttp, UrlHosts) {
+  EXPECT_EQ(url_host("127.0.0.1", "ignored"), "127.0.0.1");
+  EXPECT_EQ(url_host("0.0.0.0", "learner.example"), "learner.example");
+  EXPECT_EQ(url_host("::", "::1"), "[::1]");
+  EXPECT_FALSE(url_host("*", "").empty());
+}
+
+TEST(MetricsHttp, UnreachableIsReportedNotThrown) {
+  std::string error;
+  EXPECT_FALSE(http_get("http://127.0.0.1:1/metrics", 500, &error));
+  EXPECT_FALSE(error.empty());
+  EXPECT_FALSE(http_get("ftp://x/metrics", 500, &error));
+}
+
+}  // namespace
+}  // namespace pamdp::metrics
