@@ -7,8 +7,10 @@
 namespace pamdp::hfo {
 namespace {
 
-// Cycles of ball path the goalie looks ahead.
+// Cycles of ball path the goalie looks ahead, and the speed below which it counts the ball as
+// stopped (it then rolls less than 2 mm more).
 constexpr int kHorizon = 40;
+constexpr double kBallAtRest = 1e-4;
 // Distance at which the goalie counts the ball as won at the end of a cycle: a little inside
 // the referee's 1.085 m (and the 1.2 m catch), as a margin for movement and kick noise.
 constexpr double kGoalieReach = 0.9;
@@ -60,21 +62,28 @@ double relative_deg(Vec2 d, double body_deg) {
   return wrap_deg(std::atan2(d.y, d.x) * kRadToDeg - body_deg);
 }
 
-// Cycles `p` needs to get within `reach` of `target`: a turn if the target is off the body axis,
+// A player as the reach estimate sees it: position and body direction.
+struct Mover {
+  Vec2 pos;
+  Vec2 body;  // unit vector of the body angle
+  explicit Mover(const PlayerState& p)
+      : pos(p.pos), body{std::cos(p.body_deg * kDegToRad), std::sin(p.body_deg * kDegToRad)} {}
+};
+
+// Cycles `m` needs to get within `reach` of `target`: a turn if the target is off the body axis,
 // then full dashes. kHorizon + 1 if it cannot within the horizon.
-int cycles_to_reach(const PlayerState& p, Vec2 target, double reach) {
-  const Vec2 d = target - p.pos;
-  const double need = d.r() - reach;
+int cycles_to_reach(const Mover& m, Vec2 target, double reach) {
+  static const double kCosTurnThreshold = std::cos(kTurnThresholdDeg * kDegToRad);
+  const Vec2 d = target - m.pos;
+  const double dist = d.r();
+  const double need = dist - reach;
   if (need <= 0.0) {
     return 0;
   }
-  const int turn = std::fabs(relative_deg(d, p.body_deg)) > kTurnThresholdDeg ? 1 : 0;
-  for (int n = 1; n + turn <= kHorizon; ++n) {
-    if (kDashReach[n] >= need) {
-      return n + turn;
-    }
-  }
-  return kHorizon + 1;
+  const int turn = d.dot(m.body) < kCosTurnThreshold * dist ? 1 : 0;
+  const auto* it = std::lower_bound(kDashReach.begin() + 1, kDashReach.end(), need);
+  const int n = static_cast<int>(it - kDashReach.begin()) + turn;
+  return n <= kHorizon ? n : kHorizon + 1;
 }
 
 // One command that brings `p` toward `target`, stopping there: turn first when the target is
@@ -120,6 +129,8 @@ GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
       attacker = &p;
     }
   }
+  const Mover keeper(me);
+  const Mover opponent(attacker != nullptr ? *attacker : me);
   Vec2 bp = ball.pos;
   Vec2 bv = ball.vel;
   bool into_goal = false;
@@ -133,10 +144,21 @@ GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
     }
     bp = next;
     bv *= kBallDecay;
-    if (attacker != nullptr && attacker_cycles > kHorizon && cycles_to_reach(*attacker, bp, kAttackerReach) <= k) {
+    if (bv.r2() < kBallAtRest * kBallAtRest) {
+      // The ball has (all but) stopped at bp: the first cycle each player can be there.
+      if (attacker != nullptr && attacker_cycles > kHorizon) {
+        attacker_cycles = std::max(k, cycles_to_reach(opponent, bp, kAttackerReach));
+      }
+      const int mine = std::max(k, cycles_to_reach(keeper, bp, kGoalieReach));
+      if (in_penalty_area(bp) && mine <= kHorizon && mine < attacker_cycles) {
+        return go_to(me, bp);
+      }
+      break;
+    }
+    if (attacker != nullptr && attacker_cycles > kHorizon && cycles_to_reach(opponent, bp, kAttackerReach) <= k) {
       attacker_cycles = k;
     }
-    if (!in_penalty_area(bp) || cycles_to_reach(me, bp, kGoalieReach) > k) {
+    if (!in_penalty_area(bp) || cycles_to_reach(keeper, bp, kGoalieReach) > k) {
       continue;
     }
     // First reachable point of the path: worth going if the attacker is not there first.
