@@ -7,7 +7,8 @@
 #                           [--resume DIR] [--port P] [--duration SECONDS] [--set key=value ...]
 #
 # Defaults: one actor per core, 2 shards, deploy/configs/fast.toml, runs/cluster-<time>,
-# learner on 127.0.0.1:5555 (weights on 5556). Builds build/bin/pamdp first if it is missing.
+# learner on 127.0.0.1:5555 (weights on 5556). Builds build/bin/pamdp first if it is missing
+# (PAMDP_BIN=path/to/pamdp runs another build instead).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -48,13 +49,15 @@ if [[ -z $resume ]]; then
   [[ -f $config ]] || die "config '$config' not found (presets: deploy/configs/*.toml)"
 fi
 
-if [[ ! -x build/bin/pamdp ]]; then
+if [[ -n ${PAMDP_BIN:-} ]]; then
+  [[ -x $PAMDP_BIN ]] || die "PAMDP_BIN=$PAMDP_BIN is not an executable"
+elif [[ ! -x build/bin/pamdp ]]; then
   echo "local-cluster: building build/bin/pamdp (first run)..." >&2
   deploy/install-deps.sh
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build --target pamdp -j "$cores" >/dev/null
 fi
-bin=$root/build/bin/pamdp
+bin=${PAMDP_BIN:-$root/build/bin/pamdp}
 
 for p in $port $((port + 1)); do
   if (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
@@ -110,6 +113,7 @@ local-cluster: learner + $shards shards + $actors actors on this machine
   logs:          $run_dir/logs/{learner,shard-*,actor-*}.log
   learner:       $join (weights on tcp://127.0.0.1:$((port + 1)))
   add an actor:  $bin actor --join $join
+  watch it:      $bin monitor --join $join   (metrics URLs: $run_dir/metrics_urls.txt)
 Ctrl-C stops everything and leaves the run resumable.
 EOF
 
