@@ -13,6 +13,8 @@ namespace {
 const Choices<BoundMethod> kBounds{
     {"inverting", BoundMethod::kInverting}, {"zeroing", BoundMethod::kZeroing}, {"squashing", BoundMethod::kSquashing}};
 const Choices<std::string> kEnvs{{"hfo", "hfo"}, {"reach_stop", "reach_stop"}};
+const Choices<UpdateDevice> kDevices{
+    {"auto", UpdateDevice::kAuto}, {"cpu", UpdateDevice::kCpu}, {"cuda", UpdateDevice::kCuda}};
 
 // Splits "a.b.c" into {"a", "b", "c"}.
 std::vector<std::string> split_path(const std::string& key) {
@@ -54,6 +56,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("ddpg.init_std", c.ddpg.init_std, 0.0, 10.0);
   v.real("ddpg.critic_output_init_std", c.ddpg.critic_output_init_std, 0.0, 10.0);
   v.real("ddpg.critic_output_init_bias", c.ddpg.critic_output_init_bias, -1e6, 1e6);
+  v.choice("ddpg.device", c.ddpg.device, kDevices);
 
   v.real("exploration.epsilon_start", c.exploration.epsilon_start, 0.0, 1.0);
   v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);

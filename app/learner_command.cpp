@@ -24,6 +24,7 @@
 #include "learner/checkpoint.hpp"
 #include "learner/evaluation.hpp"
 #include "learner/learner_server.hpp"
+#include "learner/update_backend.hpp"
 
 namespace pamdp::app {
 namespace {
@@ -90,6 +91,8 @@ void run_learner(const LearnerCliOptions& o) {
     meta = load_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg);
   }
   meta.config_toml = config_text;
+  // Built after the checkpoint is loaded: a GPU backend starts from the host state.
+  const std::unique_ptr<UpdateBackend> backend = make_update_backend(ddpg, c.ddpg.device);
 
   LearnerServerConfig sc;
   sc.join_bind = c.cluster.learner_bind;
@@ -120,7 +123,7 @@ void run_learner(const LearnerCliOptions& o) {
     sc.curve_client = keys.client;
     auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
   }
-  LearnerServer server(ctx, ddpg, sc);
+  LearnerServer server(ctx, *backend, sc);
   g_server = &server;
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);
@@ -156,6 +159,7 @@ void run_learner(const LearnerCliOptions& o) {
   auto save = [&] {
     meta.elapsed_seconds = elapsed();
     meta.episodes = episode_count;
+    backend->sync_to_host();
     save_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg, meta);
     last_checkpoint = elapsed();
   };
@@ -176,6 +180,7 @@ void run_learner(const LearnerCliOptions& o) {
     last_stats = s;
     const int64_t every = c.train.eval_every_updates;
     if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
+      backend->sync_actor_to_host();
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration);
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
       have_eval = true;

@@ -17,6 +17,7 @@
 #include "core/files.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/update_backend.hpp"
 #include "replay/replay_buffer.hpp"
 #include "replay/replay_snapshot.hpp"
 
@@ -90,6 +91,7 @@ class Trainer {
         obs_dim_(env_->observation_size()),
         width_(space_.output_width()),
         ddpg_(obs_dim_, space_, c.ddpg, mix(c.seed, 1)),
+        backend_(make_update_backend(ddpg_, c.ddpg.device)),
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix(c.seed, 2)),
         sample_rng_(mix(c.seed, 3)),
@@ -121,6 +123,11 @@ class Trainer {
   int obs_dim_;
   int width_;
   Ddpg ddpg_;
+  // Runs the updates (CPU or GPU). With the GPU the host actor that acts here is refreshed from
+  // the device every cluster.publish_every_updates updates (the staleness distributed actors
+  // see) and at every episode end, a schedule fixed by update and episode counts, so a resumed
+  // run still replays the same actions; on the CPU every sync is a no-op.
+  std::unique_ptr<UpdateBackend> backend_;
   ReplayBuffer replay_;
   EpsilonGreedy explore_;
   Rng sample_rng_;
@@ -149,6 +156,7 @@ class Trainer {
 void Trainer::resume() {
   const std::string ck = (fs::path(o_.run_dir) / "checkpoint.ckpt").string();
   const CheckpointMeta meta = load_checkpoint(ck, ddpg_);
+  backend_->load_from_host();
   if (meta.rng_states.size() != 2) {
     throw std::runtime_error("checkpoint '" + ck + "' holds " + std::to_string(meta.rng_states.size()) +
                              " random streams; a train run writes 2");
@@ -172,6 +180,7 @@ void Trainer::save() {
   meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
   // Replay first: a checkpoint on disk always has a replay snapshot at least as new.
   save_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
+  backend_->sync_to_host();
   save_checkpoint((fs::path(o_.run_dir) / "checkpoint.ckpt").string(), ddpg_, meta);
   last_checkpoint_ = elapsed();
 }
@@ -193,6 +202,7 @@ void Trainer::run_eval() {
   if (c_.train.eval_episodes <= 0) {
     return;
   }
+  backend_->sync_actor_to_host();
   GreedyActorPolicy policy(ddpg_, space_, exploration_);
   last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, mix(c_.seed, 1000 + ddpg_.updates()));
   have_eval_ = true;
@@ -302,11 +312,14 @@ TrainSummary Trainer::run() {
             Eigen::Map<const Eigen::VectorXf>(batch_.terminal.data(), B),
             Eigen::Map<const Eigen::VectorXf>(batch_.mc_returns.data(), B),
         };
-        last_stats_ = ddpg_.update(view);
+        last_stats_ = backend_->update(view);
         if (o_.metrics != nullptr) {
           o_.metrics->on_update(last_stats_, ddpg_.updates(), B);
         }
         update_credit_ -= 1.0;
+        if (ddpg_.updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {
+          backend_->sync_actor_to_host();
+        }
       }
       if (replay_.size() < c_.replay.warmup) {
         update_credit_ = std::min(update_credit_, 1.0);  // no debt piles up during warm-up
@@ -315,6 +328,7 @@ TrainSummary Trainer::run() {
     } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
 
     episode_.flush(replay_, c_.ddpg.gamma);
+    backend_->sync_actor_to_host();
     ++episodes_;
     const bool success = sr.status == env_->success_status();
     recent_.add(ep_return, steps, success);

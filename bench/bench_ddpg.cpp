@@ -1,6 +1,7 @@
-// BM_DdpgUpdate/32: one full DDPG update of the paper's networks (58 -> 1024 -> 512 -> 256 ->
-// 128 -> 4+6 actor, 68 -> ... -> 1 critic) at batch 32 with inverting gradients, through the
-// learner's own Ddpg class; items = updates.
+// BM_DdpgUpdate/32 (/128, /1024): one full DDPG update of the paper's networks (58 -> 1024 ->
+// 512 -> 256 -> 128 -> 4+6 actor, 68 -> ... -> 1 critic) at batch 32 (128, 1024) with inverting
+// gradients, through the learner's own Ddpg class; items = updates. The GPU versions are in
+// bench_ddpg_cuda.cpp.
 // BM_GemmRoofline: Eigen float GEMM on this core, the roofline the update is measured against
 // (items = FLOP, so items_per_second reads as FLOP/s).
 #include <benchmark/benchmark.h>
@@ -66,7 +67,7 @@ void BM_DdpgUpdate(benchmark::State& state) {
   state.counters["GFLOP/s"] =
       benchmark::Counter(flop * static_cast<double>(state.iterations()) / 1e9, benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_DdpgUpdate)->Arg(32)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DdpgUpdate)->Arg(32)->Arg(128)->Arg(1024)->Unit(benchmark::kMillisecond);
 
 // C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate of Eigen here.
 void BM_GemmRoofline(benchmark::State& state) {

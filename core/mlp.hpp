@@ -45,6 +45,7 @@ class Mlp {
   [[nodiscard]] int output_width() const { return widths_.back(); }
   [[nodiscard]] int num_layers() const { return static_cast<int>(widths_.size()) - 1; }
   [[nodiscard]] int max_batch() const { return max_batch_; }
+  [[nodiscard]] Scalar leaky_slope() const { return slope_; }
   [[nodiscard]] int64_t num_params() const { return static_cast<int64_t>(params_.size()); }
 
   // Flat parameter and gradient vectors (same layout).

@@ -23,6 +23,11 @@ using ConstArrayMap = Eigen::Map<const Eigen::Array<Scalar, Eigen::Dynamic, 1>>;
 
 }  // namespace
 
+double adam_step_size(const AdamConfig& config, int64_t t) {
+  const auto tt = static_cast<double>(t);
+  return config.learning_rate * std::sqrt(1.0 - std::pow(config.beta2, tt)) / (1.0 - std::pow(config.beta1, tt));
+}
+
 template <typename Scalar>
 Adam<Scalar>::Adam(int64_t num_params, const AdamConfig& config)
     : config_(config), m_(static_cast<size_t>(num_params), Scalar(0)), v_(static_cast<size_t>(num_params), Scalar(0)) {
@@ -37,11 +42,9 @@ void Adam<Scalar>::step(std::span<Scalar> params, std::span<const Scalar> grads)
     misuse("Adam::step: params and grads must have num_params elements");
   }
   ++t_;
-  const double t = static_cast<double>(t_);
   // Caffe folds both bias corrections into the step size and adds eps to sqrt(v) uncorrected,
   // which differs slightly from Kingma & Ba's eps placement; the paper's code used Caffe.
-  const auto step_size = static_cast<Scalar>(config_.learning_rate * std::sqrt(1.0 - std::pow(config_.beta2, t)) /
-                                             (1.0 - std::pow(config_.beta1, t)));
+  const auto step_size = static_cast<Scalar>(adam_step_size(config_, t_));
   const auto b1 = static_cast<Scalar>(config_.beta1);
   const auto b2 = static_cast<Scalar>(config_.beta2);
   const auto eps = static_cast<Scalar>(config_.epsilon);

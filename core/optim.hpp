@@ -20,6 +20,10 @@ struct AdamConfig {
 // Caffe Adam (reference §7.4): with t = number of steps taken including this one,
 //   m <- b1 m + (1 - b1) g;  v <- b2 v + (1 - b2) g^2;
 //   theta <- theta - lr * sqrt(1 - b2^t) / (1 - b1^t) * m / (sqrt(v) + eps).
+// adam_step_size is lr * sqrt(1 - b2^t) / (1 - b1^t), in double: step t casts it to Scalar
+// (shared with the CUDA learner, which computes it on the host the same way).
+double adam_step_size(const AdamConfig& config, int64_t t);
+
 template <typename Scalar>
 class Adam {
  public:

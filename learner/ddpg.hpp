@@ -22,6 +22,9 @@
 
 namespace pamdp {
 
+// Where update() runs (learner/update_backend.hpp): kAuto takes a CUDA device when one is present.
+enum class UpdateDevice { kAuto, kCpu, kCuda };
+
 struct DdpgConfig {
   std::vector<int> hidden = {1024, 512, 256, 128};  // both networks, as in the paper
   double actor_learning_rate = 1e-3;
@@ -38,6 +41,7 @@ struct DdpgConfig {
   double init_std = 0.01;
   double critic_output_init_std = 0.05;  // the paper-era code's critic output layer
   double critic_output_init_bias = 1.0;
+  UpdateDevice device = UpdateDevice::kAuto;  // read by make_update_backend, not by Ddpg itself
 };
 
 // A minibatch, one sample per column. Not owned.

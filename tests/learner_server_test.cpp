@@ -33,6 +33,7 @@ struct Running {
   net::Context ctx;
   toy::ReachStopEnv env;
   Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
   std::unique_ptr<LearnerServer> server;
   std::thread thread;
   std::atomic<bool> done{false};
@@ -44,7 +45,7 @@ struct Running {
     c.publish_every_updates = 5;
     c.max_updates = 20;
     c.peer_timeout_ms = 60000;
-    server = std::make_unique<LearnerServer>(ctx, ddpg, c);
+    server = std::make_unique<LearnerServer>(ctx, backend, c);
     thread = std::thread([this] {
       server->run();  // returns by itself after max_updates
       done.store(true);

@@ -2,15 +2,18 @@
 // format, misuse, updates that allocate nothing, and a real scrape over loopback.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "app/role_metrics.hpp"
 #include "core/metrics.hpp"
 #include "core/metrics_http.hpp"
 #include "counting_new.hpp"
+#include "envs/toy/reach_stop.hpp"
 
 namespace pamdp::metrics {
 namespace {
@@ -98,6 +101,44 @@ TEST(Metrics, UpdatesAllocateNothing) {
   }
   EXPECT_EQ(count.count(), 0);
   EXPECT_EQ(c.value(), 1000);
+}
+
+// The calls the env loops and update paths make (app/role_metrics.hpp).
+TEST(Metrics, RoleUpdatesAllocateNothing) {
+  toy::ReachStopEnv env;
+  Registry train_registry;
+  app::TrainMetrics train(train_registry, env, 1000);
+  Registry actor_registry;
+  ActorCounters counters;
+  app::ActorMetrics actor(actor_registry, counters, env);
+  UpdateStats stats;
+  stats.critic_loss = 0.5F;
+  stats.params_at_bound_fraction = 0.25F;
+  {
+    testing::alloc::CountAllocations count;
+    for (int i = 1; i <= 300; ++i) {
+      train.on_step(0.5);
+      train.on_update(stats, i, 32);
+      train.on_episode(i % 2 == 0 ? toy::ReachStopEnv::kSuccess : toy::ReachStopEnv::kWrongStop, 1.0, 4,
+                       std::min(i * 4, 1000));
+      actor.on_episode(i % 4, 2.0, 3);  // 0 is not an outcome: counted as OTHER
+    }
+    EXPECT_EQ(count.count(), 0);
+  }
+  const std::string t = train_registry.render();
+  EXPECT_NE(t.find("pamdp_episodes_total 300\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_goals_total 150\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_episode_outcomes_total{outcome=\"SUCCESS\"} 150\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_goal_rate_100 0.5\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_updates_total 300\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_replay_transitions_sampled_total 9600\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_replay_fill_ratio 1\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_actor_params_at_bound_ratio 0.25\n"), std::string::npos) << t;
+  counters.env_steps.store(77);
+  const std::string a = actor_registry.render();
+  EXPECT_NE(a.find("pamdp_env_steps_total 77\n"), std::string::npos) << a;
+  EXPECT_NE(a.find("pamdp_episode_outcomes_total{outcome=\"OTHER\"} 75\n"), std::string::npos) << a;
+  EXPECT_NE(a.find("pamdp_episode_return_mean_100 2\n"), std::string::npos) << a;
 }
 
 TEST(MetricsHttp, ServesAndFetchesOverLoopback) {

@@ -1,0 +1,41 @@
+#include "learner/update_backend.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "core/log.hpp"
+#include "learner/cuda/cuda_update_backend.hpp"
+
+namespace pamdp {
+
+const char* update_device_name(UpdateDevice device) {
+  switch (device) {
+    case UpdateDevice::kAuto: return "auto";
+    case UpdateDevice::kCpu: return "cpu";
+    case UpdateDevice::kCuda: return "cuda";
+  }
+  return "?";
+}
+
+std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice device) {
+  if (device == UpdateDevice::kCpu) {
+    return std::make_unique<CpuUpdateBackend>(ddpg);
+  }
+  std::string why;
+  const bool have_device = cuda_device_count(&why) > 0;
+  if (device == UpdateDevice::kCuda) {
+    if (!have_device) {
+      throw std::runtime_error("ddpg.device = \"cuda\" but no CUDA device is usable (" + why +
+                               "); use ddpg.device = \"cpu\" or \"auto\"");
+    }
+    return make_cuda_update_backend(ddpg);
+  }
+  if (have_device) {
+    log::info("learner: ddpg.device = auto: updates run on the GPU ({})", cuda_device_description());
+    return make_cuda_update_backend(ddpg);
+  }
+  log::info("learner: ddpg.device = auto: no usable CUDA device ({}); updates run on the CPU", why);
+  return std::make_unique<CpuUpdateBackend>(ddpg);
+}
+
+}  // namespace pamdp
