@@ -63,7 +63,8 @@ void register_sim(CLI::App& app) {
   sim->require_subcommand(1);
   auto opts = std::make_shared<TraceOptions>();
   CLI::App* trace = sim->add_subcommand(
-      "trace", "replay an action script from a given state and print step,status,reward,f0..f57 as CSV");
+      "trace",
+      "replay an action script from a given state and print step,status,reward,f0..f57 (f0..f65 with --goalie) as CSV");
   trace
       ->add_option("--init", opts->init, "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}}")
       ->required()
