@@ -6,6 +6,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -150,6 +152,81 @@ TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   EXPECT_GE(run.server->counters().weights_version, 2);
   // junk, wrong type, truncated, wrong-width reply.
   EXPECT_EQ(run.server->counters().malformed_messages, 4);
+}
+
+// Waits for an envelope of the given payload type on `s` (skipping others); nullptr on timeout.
+const wire::Envelope* await_payload(net::Socket& s, net::Message& m, wire::Payload type) {
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < deadline) {
+    if (!s.recv(m, 100)) {
+      continue;
+    }
+    const wire::Envelope* env = wire::open_envelope(m.bytes());
+    if (env != nullptr && env->payload_type() == type) {
+      return env;
+    }
+  }
+  return nullptr;
+}
+
+TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
+  LearnerServerConfig c;
+  c.join_bind = "tcp://127.0.0.1:*";
+  c.weights_bind = "tcp://127.0.0.1:*";
+  c.config_toml = "[env]\nname = \"reach_stop\"\n";
+  c.peer_timeout_ms = 60000;
+  c.metrics_url = "http://learner:1/metrics";
+  LearnerServer server(ctx, backend, c);
+  std::mutex mutex;
+  std::vector<std::string> written;
+  int writes = 0;
+  server.on_metrics_urls = [&](const std::vector<std::string>& urls) {
+    const std::lock_guard lock(mutex);
+    written = urls;
+    ++writes;
+  };
+  std::thread thread([&] { server.run(); });
+
+  flatbuffers::FlatBufferBuilder fbb;
+  net::Message m;
+  net::Socket sample(ctx, net::SocketType::kRouter);
+  const std::string sample_endpoint = sample.bind("tcp://127.0.0.1:*");
+  net::Socket shard(ctx, net::SocketType::kDealer);
+  shard.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0,
+                           "http://shard:2/metrics");
+  ASSERT_TRUE(shard.send(wire::bytes_of(fbb), 1000));
+  ASSERT_NE(await_payload(shard, m, wire::Payload::ClusterMap), nullptr);
+  net::Socket actor(ctx, net::SocketType::kDealer);
+  actor.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Actor, "actor", "", "", 1, "http://actor:3/metrics");
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  ASSERT_NE(await_payload(actor, m, wire::Payload::ClusterMap), nullptr);
+
+  // A monitor asks on its own DEALER: the learner first, then shards, then actors.
+  net::Socket monitor(ctx, net::SocketType::kDealer);
+  monitor.connect(server.join_endpoint());
+  wire::build_metrics_urls_request(fbb);
+  ASSERT_TRUE(monitor.send(wire::bytes_of(fbb), 1000));
+  const wire::Envelope* answer = await_payload(monitor, m, wire::Payload::MetricsUrls);
+  ASSERT_NE(answer, nullptr);
+  std::vector<std::string> urls;
+  for (const flatbuffers::String* u : *answer->payload_as_MetricsUrls()->urls()) {
+    urls.push_back(u->str());
+  }
+  const std::vector<std::string> expected{"http://learner:1/metrics", "http://shard:2/metrics",
+                                          "http://actor:3/metrics"};
+  EXPECT_EQ(urls, expected);
+  server.stop();
+  thread.join();
+  const std::lock_guard lock(mutex);
+  EXPECT_EQ(written, expected);
+  EXPECT_EQ(writes, 3);  // at the start, and once per peer that joined with a URL
+  EXPECT_EQ(server.counters().actors_alive, 1);
 }
 
 }  // namespace
