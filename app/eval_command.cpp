@@ -47,6 +47,11 @@ void run_checkpoint_eval(const EvalOptions& o) {
   if (o.sim.no_noise) {
     c.env.hfo.noise = false;
   }
+  if (o.sim.config.goalie && !c.env.hfo.goalie) {
+    throw std::runtime_error("--goalie: " + o.checkpoint +
+                             " was trained without a goalie (env.goalie = false, 58 features); a checkpoint is "
+                             "evaluated on its own env");
+  }
   auto env = make_env(c.env);
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
