@@ -74,6 +74,7 @@ class Ddpg {
   void act(std::span<const float> obs, std::span<float> out);
   [[nodiscard]] int output_width() const { return bounds_.width(); }
   [[nodiscard]] int obs_dim() const { return obs_dim_; }
+  [[nodiscard]] int num_actions() const { return num_actions_; }  // discrete scores before the parameters
 
   UpdateStats update(const BatchView& batch);
   [[nodiscard]] int64_t updates() const { return updates_; }

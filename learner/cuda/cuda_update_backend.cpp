@@ -38,6 +38,7 @@ cuda::DeviceDdpgConfig device_config(Ddpg& ddpg) {
     case BoundMethod::kZeroing: d.bound = 1; break;
     case BoundMethod::kSquashing: d.bound = 2; break;
   }
+  d.num_actions = ddpg.num_actions();
   d.lo = ddpg.bounds().lo;
   d.hi = ddpg.bounds().hi;
   return d;
@@ -98,8 +99,10 @@ class CudaUpdateBackend final : public UpdateBackend {
   }
 
  private:
-  static UpdateStats convert(const cuda::DeviceStats& s) {
-    return {s.critic_loss, s.q_mean, s.target_mean, s.critic_grad_norm, s.actor_grad_norm};
+  [[nodiscard]] UpdateStats convert(const cuda::DeviceStats& s) const {
+    const int params = params_per_sample_ * ddpg_.config().batch_size;
+    return {s.critic_loss,      s.q_mean,          s.target_mean,
+            s.critic_grad_norm, s.actor_grad_norm, params > 0 ? s.params_at_bound / static_cast<float>(params) : 0.0F};
   }
 
   cuda::HostState host_state() {
@@ -114,6 +117,7 @@ class CudaUpdateBackend final : public UpdateBackend {
   }
 
   cuda::DeviceDdpg device_;
+  int params_per_sample_ = ddpg_.output_width() - ddpg_.num_actions();
   int64_t actor_steps_ = 0;
   int64_t critic_steps_ = 0;
   UpdateStats last_;

@@ -47,7 +47,8 @@ constexpr int kStatQ = 1;
 constexpr int kStatTarget = 2;
 constexpr int kStatCriticNorm = 3;
 constexpr int kStatActorNorm = 4;
-constexpr int kStats = 5;
+constexpr int kStatAtBound = 5;
+constexpr int kStats = 6;
 
 void check(cudaError_t e, const char* what) {
   if (e != cudaSuccess) {
@@ -245,6 +246,7 @@ __global__ void critic_loss_kernel(const float* __restrict__ q_next, const float
   q_sum = block_sum(q_sum, shared);
   y_sum = block_sum(y_sum, shared);
   if (threadIdx.x == 0) {
+    stats[kStatAtBound] = 0.0F;  // counted later in this update by gradient_bounds_kernel
     stats[kStatLoss] = static_cast<float>(loss / batch);
     stats[kStatQ] = static_cast<float>(q_sum / batch);
     stats[kStatTarget] = static_cast<float>(y_sum / batch);
@@ -252,10 +254,13 @@ __global__ void critic_loss_kernel(const float* __restrict__ q_next, const float
 }
 
 // learner/gradient_bounds.cpp on the device: grad (width x batch) rewritten in place; p is the
-// output the critic saw (ld p_ld), raw the actor's pre-squash output.
+// output the critic saw (ld p_ld), raw the actor's pre-squash output. Also counts the
+// continuous outputs (rows >= num_actions) at or past a bound into *at_bound (float adds of 1
+// are exact, so the count does not depend on their order).
 __global__ void gradient_bounds_kernel(float* __restrict__ grad, const float* __restrict__ p, int p_ld,
                                        const float* __restrict__ raw, int width, int batch, int method,
-                                       const float* __restrict__ lo, const float* __restrict__ hi) {
+                                       const float* __restrict__ lo, const float* __restrict__ hi, int num_actions,
+                                       float* __restrict__ at_bound) {
   const int64_t n = int64_t{width} * batch;
   const int64_t i = blockIdx.x * int64_t{blockDim.x} + threadIdx.x;
   if (i >= n) {
@@ -264,13 +269,15 @@ __global__ void gradient_bounds_kernel(float* __restrict__ grad, const float* __
   const int r = static_cast<int>(i % width);
   const float l = lo[r];
   const float h = hi[r];
+  const float pv = p[(i / width) * p_ld + r];
+  if (r >= num_actions && (pv <= l || pv >= h)) {
+    atomicAdd(at_bound, 1.0F);
+  }
   float g = grad[i];
   if (method == 0) {  // inverting
-    const float v = p[(i / width) * p_ld + r];
-    g *= g < 0.0F ? (h - v) / (h - l) : (v - l) / (h - l);
+    g *= g < 0.0F ? (h - pv) / (h - l) : (pv - l) / (h - l);
   } else if (method == 1) {  // zeroing
-    const float v = p[(i / width) * p_ld + r];
-    if ((g < 0.0F && v >= h) || (g > 0.0F && v <= l)) {
+    if ((g < 0.0F && pv >= h) || (g > 0.0F && pv <= l)) {
       g = 0.0F;
     }
   } else {  // squashing
@@ -406,6 +413,8 @@ struct DeviceDdpg::Impl {
   cudaEvent_t forked = nullptr;
   cudaEvent_t targets_done = nullptr;
   cudaEvent_t actor_forward_done = nullptr;
+  cudaEvent_t dz_ready = nullptr;    // backward(): a layer's dLoss/dz is ready on lane 0
+  cudaEvent_t grads_done = nullptr;  // backward(): lane 1 has written every [dW | db]
 
   Net actor, critic;
   Pass pass_target_actor, pass_target_critic, pass_critic, pass_actor;
@@ -485,7 +494,7 @@ struct DeviceDdpg::Impl {
     }
     stream = lanes[0].stream;
     check(cudaStreamCreateWithFlags(&copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
-    for (cudaEvent_t* e : {&forked, &targets_done, &actor_forward_done}) {
+    for (cudaEvent_t* e : {&forked, &targets_done, &actor_forward_done, &dz_ready, &grads_done}) {
       check(cudaEventCreateWithFlags(e, cudaEventDisableTiming), "cudaEventCreate");
     }
 
@@ -544,7 +553,7 @@ struct DeviceDdpg::Impl {
     if (copy_stream != nullptr) {
       cudaStreamSynchronize(copy_stream);
     }
-    for (cudaEvent_t e : {forked, targets_done, actor_forward_done}) {
+    for (cudaEvent_t e : {forked, targets_done, actor_forward_done, dz_ready, grads_done}) {
       if (e != nullptr) {
         cudaEventDestroy(e);
       }
@@ -609,11 +618,17 @@ struct DeviceDdpg::Impl {
   }
 
   // Backward pass of the last forward() of `net` on `input` with dLoss/doutput `d_out`
-  // (widths.back() x B). With param_grads, writes net.grads; with input_rows > 0, writes
-  // dLoss/dinput for input rows [input_row0, input_row0 + input_rows) into input_grad
-  // (input_rows x B).
+  // (widths.back() x B), queued on lane 0. With param_grads, writes net.grads; with
+  // input_rows > 0, writes dLoss/dinput for input rows [input_row0, input_row0 + input_rows)
+  // into input_grad (input_rows x B).
+  //
+  // The [dW | db] products run on lane 1, off the chain of input gradients: each needs only its
+  // layer's dz and input, which lane 0 does not write again in this pass, and lane 0 waits for
+  // all of them before returning (the norm and Adam read them; the next forward pass rewrites
+  // the inputs and deltas they read).
   void backward(Net& net, const float* input, Pass& pass, const float* d_out, bool param_grads, int input_row0,
                 int input_rows, float* input_grad) {
+    const Lane& side = lanes[1];
     const float* dz = d_out;  // leading dimension: the layer's width
     for (int l = net.layers() - 1; l >= 0; --l) {
       const int out = net.widths[l + 1];
@@ -621,9 +636,11 @@ struct DeviceDdpg::Impl {
       const float* a_prev = l == 0 ? input : pass.act[l].get();
       const float* w = net.params.get() + net.offsets[l];
       if (param_grads) {
+        check(cudaEventRecord(dz_ready, stream), "cudaEventRecord");
+        check(cudaStreamWaitEvent(side.stream, dz_ready, 0), "cudaStreamWaitEvent");
         // [dW | db] (out x (in + 1)) = dz (out x B) * [a; 1]^T.
-        gemm(lanes[0], CUBLAS_OP_N, CUBLAS_OP_T, out, in + 1, B, dz, out, a_prev, in + 1,
-             net.grads.get() + net.offsets[l], out);
+        gemm(side, CUBLAS_OP_N, CUBLAS_OP_T, out, in + 1, B, dz, out, a_prev, in + 1, net.grads.get() + net.offsets[l],
+             out);
       }
       if (l > 0) {
         float* d_prev = pass.delta[l - 1].get();
@@ -638,6 +655,10 @@ struct DeviceDdpg::Impl {
         gemm(lanes[0], CUBLAS_OP_T, CUBLAS_OP_N, input_rows, B, out, w + int64_t{input_row0} * out, out, dz, out,
              input_grad, input_rows);
       }
+    }
+    if (param_grads) {
+      check(cudaEventRecord(grads_done, side.stream), "cudaEventRecord");
+      check(cudaStreamWaitEvent(stream, grads_done, 0), "cudaStreamWaitEvent");
     }
   }
 
@@ -701,7 +722,8 @@ struct DeviceDdpg::Impl {
     forward(main, critic, critic.params.get(), critic_in_pi.get(), pass_critic);
     backward(critic, critic_in_pi.get(), pass_critic, minus_ones.get(), false, obs, w, d_action.get());
     gradient_bounds_kernel<<<blocks_for(int64_t{w} * B), kThreads, 0, main.stream>>>(
-        d_action.get(), critic_in_pi.get() + obs, obs + w + 1, pass_actor.out.get(), w, B, c.bound, lo.get(), hi.get());
+        d_action.get(), critic_in_pi.get() + obs, obs + w + 1, pass_actor.out.get(), w, B, c.bound, lo.get(), hi.get(),
+        c.num_actions, stats.get() + kStatAtBound);
     check_launch("gradient_bounds_kernel");
     backward(actor, actor_in.get(), pass_actor, d_action.get(), true, 0, 0, nullptr);
     // 4. Adam and the soft target updates (fused; the critic's target above).
@@ -720,7 +742,7 @@ struct DeviceDdpg::Impl {
 
   DeviceStats stats_of(const Slot& s) const {
     const float* h = s.host_stats.get();
-    return {h[kStatLoss], h[kStatQ], h[kStatTarget], h[kStatCriticNorm], h[kStatActorNorm]};
+    return {h[kStatLoss], h[kStatQ], h[kStatTarget], h[kStatCriticNorm], h[kStatActorNorm], h[kStatAtBound]};
   }
 };
 

@@ -35,6 +35,7 @@ struct DeviceDdpgConfig {
   float adam_beta2 = 0.999F;
   float adam_epsilon = 1e-8F;
   int bound = 0;              // 0 inverting, 1 zeroing, 2 squashing (learner/gradient_bounds.hpp)
+  int num_actions = 0;        // outputs before the continuous parameters (for params_at_bound)
   std::vector<float> lo, hi;  // output bounds, width each
 };
 
@@ -66,6 +67,7 @@ struct DeviceStats {
   float target_mean = 0.0F;
   float critic_grad_norm = 0.0F;
   float actor_grad_norm = 0.0F;
+  float params_at_bound = 0.0F;  // count of continuous outputs at or past a bound (exact below 2^24)
 };
 
 class DeviceDdpg {
