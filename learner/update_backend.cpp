@@ -28,11 +28,22 @@ std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice devi
       throw std::runtime_error("ddpg.device = \"cuda\" but no CUDA device is usable (" + why +
                                "); use ddpg.device = \"cpu\" or \"auto\"");
     }
-    return make_cuda_update_backend(ddpg);
+    try {
+      return make_cuda_update_backend(ddpg);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(std::string("ddpg.device = \"cuda\" but the CUDA learner could not start (") + e.what() +
+                               "); use ddpg.device = \"cpu\" or \"auto\"");
+    }
   }
   if (have_device) {
-    log::info("learner: ddpg.device = auto: updates run on the GPU ({})", cuda_device_description());
-    return make_cuda_update_backend(ddpg);
+    try {
+      std::unique_ptr<UpdateBackend> cuda = make_cuda_update_backend(ddpg);
+      log::info("learner: ddpg.device = auto: updates run on the GPU ({})", cuda_device_description());
+      return cuda;
+    } catch (const std::exception& e) {
+      // A device that is listed but unusable (busy, exclusive, out of memory) falls back too.
+      why = e.what();
+    }
   }
   log::info("learner: ddpg.device = auto: no usable CUDA device ({}); updates run on the CPU", why);
   return std::make_unique<CpuUpdateBackend>(ddpg);

@@ -69,7 +69,8 @@ class CpuUpdateBackend final : public UpdateBackend {
 
 // kCpu: the CPU backend. kCuda: the CUDA backend on device 0; throws std::runtime_error with a
 // one-line message naming the problem and the fix when this build has no CUDA support or no
-// device is usable. kAuto: CUDA when a device is usable, else the CPU; logs which it took.
+// device is usable. kAuto: CUDA when a device is usable (and the backend can be built on it),
+// else the CPU; logs which it took and why.
 std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice device);
 
 // Number of usable CUDA devices (0 in a build without CUDA, without a driver or without a
