@@ -15,5 +15,6 @@ void register_replay(CLI::App& app);
 void register_learner(CLI::App& app);
 void register_keygen(CLI::App& app);
 void register_monitor(CLI::App& app);
+void register_plot(CLI::App& app);
 
 }  // namespace pamdp::app

@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/progress.hpp"
 #include "app/sim_options.hpp"
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
@@ -41,6 +42,14 @@ void print_result(const std::string& name, const EvalResult& r, bool json) {
   }
 }
 
+// A progress bar on stderr while it plays (only on a terminal).
+EvalResult evaluate_with_progress(Env& env, Policy& policy, const EvalOptions& o) {
+  ProgressBar bar("episodes", o.episodes);
+  EvalResult r = evaluate(env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); });
+  bar.finish();
+  return r;
+}
+
 // A trained actor, with the env and bounds of the run that wrote the checkpoint.
 void run_checkpoint_eval(const EvalOptions& o) {
   ExperimentConfig c = parse_experiment_config(read_checkpoint_config(o.checkpoint), o.checkpoint + " (config)", {});
@@ -56,7 +65,7 @@ void run_checkpoint_eval(const EvalOptions& o) {
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
-  print_result("ddpg", evaluate(*env, policy, o.episodes, o.seed), o.json);
+  print_result("ddpg", evaluate_with_progress(*env, policy, o), o.json);
 }
 
 void run_eval(const EvalOptions& o) {
@@ -75,7 +84,7 @@ void run_eval(const EvalOptions& o) {
     random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
     policy = std::move(random);
   }
-  print_result(o.policy, evaluate(env, *policy, o.episodes, o.seed), o.json);
+  print_result(o.policy, evaluate_with_progress(env, *policy, o), o.json);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "app/role_metrics.hpp"
+#include "app/run_logs.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
@@ -128,17 +129,9 @@ void run_learner(const LearnerCliOptions& o) {
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);
 
-  std::ofstream metrics(fs::path(run_dir) / "metrics.csv", std::ios::app);
-  std::ofstream episodes(fs::path(run_dir) / "episodes.csv", std::ios::app);
-  if (!metrics || !episodes) {
-    throw std::runtime_error("cannot write metrics into run directory '" + run_dir + "'");
-  }
-  if (fs::file_size(fs::path(run_dir) / "metrics.csv") == 0) {
-    metrics << "wall_seconds,updates,episodes,success_rate_100,mean_return_100,mean_steps_100,critic_loss,q_mean,"
-               "updates_per_s,samples_per_s,shards,actors_joined,weights_version,malformed_messages,"
-               "waiting_for_data_ms,eval_success_rate,eval_avg_steps_to_success,eval_avg_return\n";
-    episodes << "episode,wall_seconds,updates,actor,return,steps,status\n";
-  }
+  RunLogs logs(run_dir, {"samples_per_s", "shards", "actors_joined", "weights_version", "malformed_messages",
+                         "waiting_for_data_ms"});
+  BestEval best(fs::path(run_dir) / "best_eval.txt");
 
   RecentEpisodes recent;
   UpdateStats last_stats;
@@ -154,11 +147,14 @@ void run_learner(const LearnerCliOptions& o) {
   int64_t last_samples = 0;
   double last_tick = elapsed();
   int64_t episode_count = meta.episodes;
+  int64_t env_steps = meta.env_steps;  // steps of the episodes reported so far
+  int64_t last_env_steps = env_steps;
   double last_print = -1e9;
 
   auto save = [&] {
     meta.elapsed_seconds = elapsed();
     meta.episodes = episode_count;
+    meta.env_steps = env_steps;
     backend->sync_to_host();
     save_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg, meta);
     last_checkpoint = elapsed();
@@ -172,8 +168,17 @@ void run_learner(const LearnerCliOptions& o) {
     ++episode_count;
     const bool success = e.status == env->success_status();
     recent.add(e.ret, e.steps, success);
-    episodes << episode_count << ',' << elapsed() << ',' << ddpg.updates() << ',' << e.actor_id << ',' << e.ret << ','
-             << e.steps << ',' << env->status_name(e.status) << '\n';
+    env_steps += e.steps;
+    EpisodeRow row;
+    row.episode = episode_count;
+    row.wall_seconds = elapsed();
+    row.updates = ddpg.updates();
+    row.actor = e.actor_id;
+    row.ret = e.ret;
+    row.steps = e.steps;
+    row.outcome = env->status_name(e.status);
+    row.weights_version = e.policy_version;
+    logs.episode(row);
   };
   server.on_update = [&](const UpdateStats& s) {
     learner_metrics.on_update(s, ddpg.updates());
@@ -184,6 +189,14 @@ void run_learner(const LearnerCliOptions& o) {
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration);
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
       have_eval = true;
+      if (best.offer(last_eval, ddpg.updates())) {
+        CheckpointMeta best_meta = meta;
+        best_meta.elapsed_seconds = elapsed();
+        best_meta.episodes = episode_count;
+        best_meta.env_steps = env_steps;
+        backend->sync_to_host();
+        save_checkpoint((fs::path(run_dir) / "best.ckpt").string(), ddpg, best_meta);
+      }
     }
   };
   server.on_tick = [&](const LearnerCounters& k) {
@@ -198,17 +211,32 @@ void run_learner(const LearnerCliOptions& o) {
     if (now - last_checkpoint >= c.train.checkpoint_every_seconds && c.train.checkpoint_every_seconds > 0) {
       save();
     }
-    metrics << now << ',' << ddpg.updates() << ',' << episode_count << ',' << recent.success_rate() << ','
-            << recent.mean_return() << ',' << recent.mean_steps() << ',' << last_stats.critic_loss << ','
-            << last_stats.q_mean << ',' << ups << ',' << sps << ',' << k.shards << ',' << k.actors_joined << ','
-            << k.weights_version << ',' << k.malformed_messages << ',' << k.waiting_for_data_ms << ',';
+    MetricsRow row;
+    row.wall_seconds = now;
+    row.updates = ddpg.updates();
+    row.env_steps = env_steps;
+    row.episodes = episode_count;
+    // The schedule the weights carry (actors started with --apex-epsilon use their own fixed ε).
+    row.epsilon = linear_epsilon(ddpg.updates(), exploration.epsilon_start, exploration.epsilon_end,
+                                 exploration.epsilon_anneal_updates);
+    row.success_rate_100 = recent.success_rate();
+    row.mean_return_100 = recent.mean_return();
+    row.mean_steps_100 = recent.mean_steps();
+    row.critic_loss = last_stats.critic_loss;
+    row.q_mean = last_stats.q_mean;
+    row.updates_per_s = ups;
+    row.env_steps_per_s = static_cast<double>(env_steps - last_env_steps) / dt;
+    last_env_steps = env_steps;
     if (have_eval) {
-      metrics << last_eval.goal_rate << ',' << last_eval.avg_steps_to_goal << ',' << last_eval.avg_return;
-    } else {
-      metrics << ",,";
+      row.eval = last_eval;
     }
-    metrics << '\n' << std::flush;
-    episodes << std::flush;
+    const double extras[] = {sps,
+                             static_cast<double>(k.shards),
+                             static_cast<double>(k.actors_joined),
+                             static_cast<double>(k.weights_version),
+                             static_cast<double>(k.malformed_messages),
+                             static_cast<double>(k.waiting_for_data_ms)};
+    logs.metrics(row, extras);
     if (!o.quiet && now - last_print >= c.train.log_every_seconds) {
       last_print = now;
       std::printf(

@@ -28,6 +28,7 @@ int run(int argc, char** argv) {
   pamdp::app::register_learner(app);
   pamdp::app::register_keygen(app);
   pamdp::app::register_monitor(app);
+  pamdp::app::register_plot(app);
 
   std::string valid;
   bool known = false;

@@ -6,13 +6,16 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
 #include "actor/exploration.hpp"
 #include "app/actor_policy.hpp"
 #include "app/env_factory.hpp"
+#include "app/progress.hpp"
 #include "app/role_metrics.hpp"
+#include "app/run_logs.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "learner/checkpoint.hpp"
@@ -109,6 +112,7 @@ class Trainer {
   void save();
   void log_tick(bool force);
   void run_eval();
+  void save_best();
   [[nodiscard]] bool should_stop() const;
   [[nodiscard]] double elapsed() const {
     return base_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -149,8 +153,9 @@ class Trainer {
   double last_log_ = 0.0;
   int64_t log_updates_ = 0;
   int64_t log_steps_ = 0;
-  std::ofstream metrics_;
-  std::ofstream episodes_csv_;
+  std::optional<RunLogs> logs_;
+  std::optional<BestEval> best_;
+  std::optional<ProgressBar> bar_;
 };
 
 void Trainer::resume() {
@@ -206,6 +211,23 @@ void Trainer::run_eval() {
   GreedyActorPolicy policy(ddpg_, space_, exploration_);
   last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, mix(c_.seed, 1000 + ddpg_.updates()));
   have_eval_ = true;
+  if (best_ && best_->offer(last_eval_, ddpg_.updates())) {
+    save_best();
+  }
+}
+
+// The actor (with everything else) of the best greedy evaluation so far: what `pamdp eval
+// --checkpoint RUN/best.ckpt` should be given when the final policy is worse than an earlier one.
+void Trainer::save_best() {
+  CheckpointMeta meta;
+  meta.config_toml = to_toml(c_);
+  meta.env_steps = env_steps_;
+  meta.episodes = episodes_;
+  meta.elapsed_seconds = elapsed();
+  meta.update_credit = update_credit_;
+  meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
+  backend_->sync_to_host();
+  save_checkpoint((fs::path(o_.run_dir) / "best.ckpt").string(), ddpg_, meta);
 }
 
 void Trainer::log_tick(bool force) {
@@ -221,17 +243,27 @@ void Trainer::log_tick(bool force) {
   log_steps_ = env_steps_;
   const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                     exploration_.epsilon_anneal_updates);
-  metrics_ << now << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << episodes_ << ',' << eps << ','
-           << recent_.success_rate() << ',' << recent_.mean_return() << ',' << recent_.mean_steps() << ','
-           << last_stats_.critic_loss << ',' << last_stats_.q_mean << ',' << ups << ',' << sps << ',';
+  MetricsRow row;
+  row.wall_seconds = now;
+  row.updates = ddpg_.updates();
+  row.env_steps = env_steps_;
+  row.episodes = episodes_;
+  row.epsilon = eps;
+  row.success_rate_100 = recent_.success_rate();
+  row.mean_return_100 = recent_.mean_return();
+  row.mean_steps_100 = recent_.mean_steps();
+  row.critic_loss = last_stats_.critic_loss;
+  row.q_mean = last_stats_.q_mean;
+  row.updates_per_s = ups;
+  row.env_steps_per_s = sps;
   if (have_eval_) {
-    metrics_ << last_eval_.goal_rate << ',' << last_eval_.avg_steps_to_goal << ',' << last_eval_.avg_return;
-  } else {
-    metrics_ << ",,";
+    row.eval = last_eval_;
   }
-  metrics_ << '\n' << std::flush;
-  episodes_csv_ << std::flush;  // so a killed run keeps its episode log up to the last tick
+  logs_->metrics(row);  // flushes the episode log too, so a killed run keeps it up to this row
   if (!o_.quiet) {
+    if (bar_) {
+      bar_->clear();
+    }
     std::printf(
         "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | eps %.3f | loss %.4g | Q %.3f "
         "| "
@@ -256,17 +288,10 @@ TrainSummary Trainer::run() {
     const std::string text = to_toml(c_);
     write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
   }
-  const bool fresh_metrics = !o_.resume || !fs::exists(dir / "metrics.csv");
-  metrics_.open(dir / "metrics.csv", std::ios::app);
-  episodes_csv_.open(dir / "episodes.csv", std::ios::app);
-  if (!metrics_ || !episodes_csv_) {
-    throw std::runtime_error("cannot write metrics into run directory '" + o_.run_dir + "'");
-  }
-  if (fresh_metrics) {
-    metrics_ << "wall_seconds,updates,env_steps,episodes,epsilon,success_rate_100,mean_return_100,mean_steps_100,"
-                "critic_loss,q_mean,updates_per_s,env_steps_per_s,eval_success_rate,eval_avg_steps_to_success,"
-                "eval_avg_return\n";
-    episodes_csv_ << "episode,wall_seconds,updates,env_steps,return,steps,status\n";
+  logs_.emplace(dir);
+  best_.emplace(dir / "best_eval.txt");
+  if (!o_.quiet) {
+    bar_.emplace("updates", c_.train.max_updates);
   }
   start_ = std::chrono::steady_clock::now();
   last_log_ = last_checkpoint_ = base_seconds_;
@@ -335,8 +360,18 @@ TrainSummary Trainer::run() {
     if (o_.metrics != nullptr) {
       o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()));
     }
-    episodes_csv_ << episodes_ << ',' << elapsed() << ',' << ddpg_.updates() << ',' << env_steps_ << ',' << ep_return
-                  << ',' << steps << ',' << env_->status_name(sr.status) << '\n';
+    EpisodeRow ep;
+    ep.episode = episodes_;
+    ep.wall_seconds = elapsed();
+    ep.updates = ddpg_.updates();
+    ep.ret = ep_return;
+    ep.steps = steps;
+    ep.outcome = env_->status_name(sr.status);
+    ep.weights_version = static_cast<uint64_t>(ddpg_.updates());  // one process: always the newest weights
+    logs_->episode(ep);
+    if (bar_) {
+      bar_->update(ddpg_.updates());
+    }
     if (ddpg_.updates() >= next_eval_) {
       run_eval();
       next_eval_ += c_.train.eval_every_updates;
@@ -347,7 +382,10 @@ TrainSummary Trainer::run() {
     }
   }
   save();
-  episodes_csv_.flush();
+  if (bar_) {
+    bar_->finish();
+  }
+  logs_->flush();
   TrainSummary s;
   run_eval();
   if (have_eval_) {

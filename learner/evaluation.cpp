@@ -7,7 +7,7 @@
 
 namespace pamdp {
 
-EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed) {
+EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const std::function<void(int)>& on_episode) {
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
   std::vector<int> counts(8, 0);
   EvalResult res;
@@ -44,6 +44,9 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed) {
     if (sr.status == env.success_status()) {
       ++goals;
       goal_steps += steps;
+    }
+    if (on_episode) {
+      on_episode(ep + 1);
     }
   }
   for (int s : env.outcomes()) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -22,7 +23,9 @@ struct EvalResult {
 };
 
 // Plays `episodes` episodes; the first reset uses `seed`, later ones continue the env's stream.
-EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed);
+// `on_episode`, when given, is called with the number of episodes done after each one.
+EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed,
+                    const std::function<void(int)>& on_episode = {});
 
 // One JSON object (no newline) with keys episodes, goal_rate, avg_steps_to_goal, avg_return,
 // avg_steps, outcomes.

@@ -2,6 +2,7 @@
 // parsing, checkpoints (atomic, verified, bit-for-bit resume) and an end-to-end test that
 // `pamdp train` solves the toy ReachStop PAMDP.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -261,7 +262,8 @@ app::ExperimentConfig toy_config(int64_t max_updates) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("pamdp_learner_test_" + name);
+  // The pid keeps two builds' test runs on one machine out of each other's directories.
+  const fs::path d = fs::temp_directory_path() / ("pamdp_learner_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
 }

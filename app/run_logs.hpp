@@ -1,0 +1,96 @@
+// The CSV files of a run directory, written the same way by `pamdp train` and `pamdp learner`
+// so that `pamdp plot` and anyone's script read one format:
+//
+//   metrics.csv   one row per log interval: wall_seconds, updates, env_steps, episodes, epsilon,
+//                 success_rate_100, mean_return_100, mean_steps_100, critic_loss, q_mean,
+//                 updates_per_s, env_steps_per_s, eval_success_rate, eval_avg_steps_to_success,
+//                 eval_avg_return, then the role's extra columns (the learner's: samples/s,
+//                 shards, actors, weights version, bad messages, time waiting for data).
+//   episodes.csv  one row per episode: episode, wall_seconds, updates, actor, return, steps,
+//                 outcome, weights_version.
+//
+// "success" is the env's success outcome (GOAL in HFO). Eval columns are empty until the first
+// greedy evaluation. Files are appended to (a resumed run continues them); a file whose header
+// is not this format (a run from an older version) is renamed to NAME.old-format and restarted.
+// Rows are flushed at every metrics row so a killed run keeps its log up to the last one.
+// Not thread-safe; cost: one formatted line per call.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "learner/evaluation.hpp"
+
+namespace pamdp::app {
+
+struct MetricsRow {
+  double wall_seconds = 0.0;
+  int64_t updates = 0;
+  int64_t env_steps = 0;
+  int64_t episodes = 0;
+  std::optional<double> epsilon;  // empty where there is no single schedule (Ape-X)
+  double success_rate_100 = 0.0;
+  double mean_return_100 = 0.0;
+  double mean_steps_100 = 0.0;
+  double critic_loss = 0.0;
+  double q_mean = 0.0;
+  double updates_per_s = 0.0;
+  double env_steps_per_s = 0.0;
+  std::optional<EvalResult> eval;  // the latest greedy evaluation, if any
+};
+
+struct EpisodeRow {
+  int64_t episode = 0;
+  double wall_seconds = 0.0;
+  int64_t updates = 0;
+  uint32_t actor = 0;
+  double ret = 0.0;
+  int64_t steps = 0;
+  std::string_view outcome;
+  uint64_t weights_version = 0;
+};
+
+class RunLogs {
+ public:
+  // Opens (appending) dir/metrics.csv and dir/episodes.csv. Throws std::runtime_error naming the
+  // file when one cannot be written.
+  RunLogs(const std::filesystem::path& dir, std::vector<std::string> extra_metric_columns = {});
+
+  // `extras` has one value per extra column given to the constructor.
+  void metrics(const MetricsRow& row, std::span<const double> extras = {});
+  void episode(const EpisodeRow& row);
+  void flush();
+
+  static const std::vector<std::string>& metric_columns();  // without the extras
+  static const std::vector<std::string>& episode_columns();
+
+ private:
+  std::vector<std::string> extras_;
+  std::ofstream metrics_;
+  std::ofstream episodes_;
+};
+
+// Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
+// success, then a higher return. Persisted in a small text file (the run directory's
+// best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.
+class BestEval {
+ public:
+  explicit BestEval(std::filesystem::path file);
+
+  // True when `r` beats every evaluation offered before (the first one always does); then the
+  // file is rewritten (atomically) with `r` and `updates`.
+  bool offer(const EvalResult& r, int64_t updates);
+  [[nodiscard]] const std::optional<EvalResult>& best() const { return best_; }
+
+ private:
+  std::filesystem::path file_;
+  std::optional<EvalResult> best_;
+};
+
+}  // namespace pamdp::app

@@ -1,0 +1,211 @@
+// The run directory's CSV files (app/run_logs), the best-evaluation keeper, the progress bar's
+// formatting, and `pamdp plot` on a real run directory written by `pamdp train`.
+#include "app/run_logs.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/progress.hpp"
+
+namespace pamdp::app {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("pamdp_runlogs_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> lines_of(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+TEST(RunLogs, WritesHeadersOnceAndRowsInColumnOrder) {
+  const fs::path dir = fresh_dir("rows");
+  {
+    RunLogs logs(dir, {"shards"});
+    MetricsRow row;
+    row.wall_seconds = 1.5;
+    row.updates = 100;
+    row.env_steps = 120;
+    row.episodes = 3;
+    row.epsilon = 0.5;
+    row.success_rate_100 = 0.25;
+    row.mean_return_100 = 2.0;
+    row.mean_steps_100 = 40.0;
+    row.critic_loss = 0.125;
+    row.q_mean = 0.75;
+    row.updates_per_s = 10.0;
+    row.env_steps_per_s = 12.0;
+    const double extras[] = {2.0};
+    logs.metrics(row, extras);
+    EpisodeRow ep{7, 1.25, 90, 3, 1.5, 55, "GOAL", 42};
+    logs.episode(ep);
+    logs.flush();
+  }
+  {
+    RunLogs again(dir, {"shards"});  // a resumed run appends without a second header
+    MetricsRow row;
+    EvalResult e;
+    e.goal_rate = 0.5;
+    e.avg_steps_to_goal = 70.0;
+    e.avg_return = 3.0;
+    row.eval = e;
+    const double extras[] = {1.0};
+    again.metrics(row, extras);
+  }
+  const auto m = lines_of(dir / "metrics.csv");
+  ASSERT_EQ(m.size(), 3U);
+  EXPECT_EQ(m[0],
+            "wall_seconds,updates,env_steps,episodes,epsilon,success_rate_100,mean_return_100,mean_steps_100,"
+            "critic_loss,q_mean,updates_per_s,env_steps_per_s,eval_success_rate,eval_avg_steps_to_success,"
+            "eval_avg_return,shards");
+  EXPECT_EQ(m[1], "1.5,100,120,3,0.5,0.25,2,40,0.125,0.75,10,12,,,,2");
+  EXPECT_EQ(m[2], "0,0,0,0,,0,0,0,0,0,0,0,0.5,70,3,1");  // no epsilon: an empty cell
+  const auto e = lines_of(dir / "episodes.csv");
+  ASSERT_EQ(e.size(), 2U);
+  EXPECT_EQ(e[0], "episode,wall_seconds,updates,actor,return,steps,outcome,weights_version");
+  EXPECT_EQ(e[1], "7,1.25,90,3,1.5,55,GOAL,42");
+  fs::remove_all(dir);
+}
+
+TEST(RunLogs, MovesAsideAFileOfAnotherLayout) {
+  const fs::path dir = fresh_dir("aside");
+  std::ofstream(dir / "metrics.csv") << "wall_seconds,updates,old_column\n1,2,3\n";
+  { RunLogs logs(dir); }
+  EXPECT_TRUE(fs::exists(dir / "metrics.csv.old-format"));
+  const auto m = lines_of(dir / "metrics.csv");
+  ASSERT_EQ(m.size(), 1U);
+  EXPECT_EQ(m[0].rfind("wall_seconds,updates,env_steps", 0), 0U);
+  fs::remove_all(dir);
+}
+
+TEST(RunLogs, WrongNumberOfExtrasIsMisuse) {
+  const fs::path dir = fresh_dir("extras");
+  RunLogs logs(dir, {"a", "b"});
+  const double one[] = {1.0};
+  EXPECT_THROW(logs.metrics(MetricsRow{}, one), std::logic_error);
+  fs::remove_all(dir);
+}
+
+EvalResult eval_of(double rate, double steps, double ret) {
+  EvalResult r;
+  r.goal_rate = rate;
+  r.avg_steps_to_goal = steps;
+  r.avg_return = ret;
+  return r;
+}
+
+TEST(BestEval, RateThenStepsThenReturnAndItSurvivesARestart) {
+  const fs::path dir = fresh_dir("best");
+  const fs::path file = dir / "best_eval.txt";
+  {
+    BestEval best(file);
+    EXPECT_TRUE(best.offer(eval_of(0.0, 0.0, 1.0), 10));   // the first always wins
+    EXPECT_FALSE(best.offer(eval_of(0.0, 0.0, 0.5), 20));  // same rate, lower return
+    EXPECT_TRUE(best.offer(eval_of(0.0, 0.0, 1.5), 30));   // same rate, higher return
+    EXPECT_TRUE(best.offer(eval_of(0.8, 90.0, 0.0), 40));  // higher rate beats any return
+    EXPECT_TRUE(best.offer(eval_of(0.8, 80.0, 0.0), 50));  // same rate, fewer steps
+    EXPECT_FALSE(best.offer(eval_of(0.8, 85.0, 9.0), 60));
+  }
+  BestEval resumed(file);
+  ASSERT_TRUE(resumed.best().has_value());
+  EXPECT_DOUBLE_EQ(resumed.best()->goal_rate, 0.8);
+  EXPECT_DOUBLE_EQ(resumed.best()->avg_steps_to_goal, 80.0);
+  EXPECT_FALSE(resumed.offer(eval_of(0.7, 10.0, 9.0), 70));
+  EXPECT_TRUE(resumed.offer(eval_of(0.9, 100.0, 0.0), 80));
+  fs::remove_all(dir);
+}
+
+TEST(ProgressBar, FormatsDurations) {
+  EXPECT_EQ(ProgressBar::format_duration(0.2), "0s");
+  EXPECT_EQ(ProgressBar::format_duration(59.4), "59s");
+  EXPECT_EQ(ProgressBar::format_duration(65.0), "1m05s");
+  EXPECT_EQ(ProgressBar::format_duration(7800.0), "2h10m");
+  EXPECT_EQ(ProgressBar::format_duration(-1.0), "?");
+}
+
+TEST(ProgressBar, DrawsNothingWhenStderrIsNotATerminal) {
+  if (isatty(fileno(stderr)) == 1) {
+    GTEST_SKIP() << "stderr is a terminal here";
+  }
+  ProgressBar bar("episodes", 10);
+  EXPECT_FALSE(bar.active());
+}
+
+int run(const std::string& cmd, std::string* output) {
+  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) {
+    return -1;
+  }
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) {
+    output->append(buf.data(), n);
+  }
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// A real (tiny) training run, then its curves: the run directory has the files the README
+// promises, a best checkpoint that `pamdp eval` accepts, and `pamdp plot` makes a PNG of it.
+TEST(Plot, DrawsTheCurvesOfARealRun) {
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "gnuplot is not installed (deploy/install-deps.sh installs gnuplot-nox)";
+  }
+  const fs::path dir = fresh_dir("plot");
+  const std::string pamdp = std::string(PAMDP_BIN_DIR) + "/pamdp";
+  const fs::path run_dir = dir / "toy";
+  std::string out;
+  ASSERT_EQ(run("'" + pamdp + "' train --config '" + PAMDP_SOURCE_DIR +
+                    "/deploy/configs/reach_stop.toml' --quiet --set train.max_updates=3000 "
+                    "--set train.eval_every_updates=1000 --set train.log_every_seconds=0.05 --run-dir '" +
+                    run_dir.string() + "'",
+                &out),
+            0)
+      << out;
+  for (const char* f :
+       {"config.toml", "metrics.csv", "episodes.csv", "checkpoint.ckpt", "best.ckpt", "best_eval.txt"}) {
+    EXPECT_TRUE(fs::exists(run_dir / f)) << f << " missing from the run directory";
+  }
+  out.clear();
+  EXPECT_EQ(run("'" + pamdp + "' eval --checkpoint '" + (run_dir / "best.ckpt").string() + "' --episodes 20", &out), 0)
+      << out;
+  out.clear();
+  const fs::path png = dir / "curves.png";
+  ASSERT_EQ(
+      run("'" + pamdp + "' plot '" + run_dir.string() + "' '" + run_dir.string() + "' --out '" + png.string() + "'",
+          &out),
+      0)
+      << out;
+  std::ifstream in(png, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "not a PNG: " << png;
+  EXPECT_GT(fs::file_size(png), 10000U);
+
+  out.clear();
+  EXPECT_NE(run("'" + pamdp + "' plot '" + dir.string() + "'", &out), 0);  // not a run directory
+  EXPECT_NE(out.find("no metrics.csv"), std::string::npos) << out;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pamdp::app
