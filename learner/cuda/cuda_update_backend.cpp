@@ -2,16 +2,79 @@
 // pointers): shapes and constants are taken from the Ddpg exactly as its own update() casts
 // them, and the Adam step sizes are computed here with core/optim's formula, so the device
 // applies the same step as the host would.
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <stdexcept>
+#include <string>
 
 #include "core/optim.hpp"
 #include "learner/cuda/cuda_update_backend.hpp"
 #include "learner/cuda/device_ddpg.hpp"
 
 namespace pamdp {
+
+namespace cuda {
+
+const CudaApi* cuda_api(std::string* why) {
+  static std::once_flag once;
+  static const CudaApi* api = nullptr;
+  static std::string error;
+  std::call_once(once, [] {
+    // Without the driver library there is no device: say so without loading cuBLAS.
+    if (dlopen("libcuda.so.1", RTLD_LAZY | RTLD_LOCAL) == nullptr) {
+      const char* e = dlerror();
+      error = std::string("no NVIDIA driver: ") + (e != nullptr ? e : "libcuda.so.1 not found");
+      return;
+    }
+    constexpr const char* kModule = "libpamdp_cuda.so";
+    // Next to the executable first (the build puts programs and the module in bin/).
+    std::string path = kModule;
+    char exe[PATH_MAX];
+    const ssize_t n = readlink("/proc/self/exe", exe, sizeof(exe) - 1);
+    if (n > 0) {
+      std::string dir(exe, static_cast<size_t>(n));
+      dir.resize(dir.rfind('/') + 1);
+      if (access((dir + kModule).c_str(), R_OK) == 0) {
+        path = dir + kModule;
+      }
+    }
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) {
+      const char* e = dlerror();
+      error = std::string("cannot load ") + path + ": " + (e != nullptr ? e : "?");
+      return;
+    }
+    const auto* table = static_cast<const CudaApi*>(dlsym(handle, "pamdp_cuda_api"));
+    if (table == nullptr || table->version != kCudaApiVersion) {
+      error = path + " is not this build's CUDA module (rebuild it)";
+      return;
+    }
+    api = table;
+  });
+  if (api == nullptr && why != nullptr) {
+    *why = error;
+  }
+  return api;
+}
+
+}  // namespace cuda
+
 namespace {
+
+// Only called after cuda_device_count() found a device, so the module is loaded.
+const cuda::CudaApi& api() {
+  std::string why;
+  const cuda::CudaApi* a = cuda::cuda_api(&why);
+  if (a == nullptr) {
+    throw std::runtime_error(why);
+  }
+  return *a;
+}
 
 cuda::DeviceDdpgConfig device_config(Ddpg& ddpg) {
   const DdpgConfig& c = ddpg.config();
@@ -46,8 +109,9 @@ cuda::DeviceDdpgConfig device_config(Ddpg& ddpg) {
 
 class CudaUpdateBackend final : public UpdateBackend {
  public:
-  explicit CudaUpdateBackend(Ddpg& ddpg) : UpdateBackend(ddpg), device_(device_config(ddpg)) {
-    if (device_.actor_params() != ddpg.actor().num_params() || device_.critic_params() != ddpg.critic().num_params()) {
+  explicit CudaUpdateBackend(Ddpg& ddpg) : UpdateBackend(ddpg), device_(api().create(device_config(ddpg))) {
+    if (device_->actor_params() != ddpg.actor().num_params() ||
+        device_->critic_params() != ddpg.critic().num_params()) {
       throw std::logic_error("CUDA learner: device and host parameter layouts differ");
     }
     load_from_host();
@@ -71,7 +135,7 @@ class CudaUpdateBackend final : public UpdateBackend {
     const cuda::HostBatch b{batch.states.data(),      batch.actions.data(),  batch.rewards.data(),
                             batch.next_states.data(), batch.terminal.data(), batch.mc_returns.data()};
     bool has_previous = false;
-    const cuda::DeviceStats s = device_.enqueue(b, actor_step, critic_step, &has_previous);
+    const cuda::DeviceStats s = device_->enqueue(b, actor_step, critic_step, &has_previous);
     ddpg_.set_updates(ddpg_.updates() + 1);
     if (has_previous) {
       last_ = convert(s);
@@ -80,20 +144,20 @@ class CudaUpdateBackend final : public UpdateBackend {
   }
 
   UpdateStats finish() override {
-    last_ = convert(device_.finish());
+    last_ = convert(device_->finish());
     return last_;
   }
 
   void sync_to_host() override {
-    device_.download(host_state());
+    device_->download(host_state());
     ddpg_.actor_optimizer().set_steps(actor_steps_);
     ddpg_.critic_optimizer().set_steps(critic_steps_);
   }
 
-  void sync_actor_to_host() override { device_.download_actor(ddpg_.actor().params().data()); }
+  void sync_actor_to_host() override { device_->download_actor(ddpg_.actor().params().data()); }
 
   void load_from_host() override {
-    device_.upload(host_state());
+    device_->upload(host_state());
     actor_steps_ = ddpg_.actor_optimizer().steps();
     critic_steps_ = ddpg_.critic_optimizer().steps();
   }
@@ -116,7 +180,7 @@ class CudaUpdateBackend final : public UpdateBackend {
             ddpg_.critic_optimizer().second_moment().data()};
   }
 
-  cuda::DeviceDdpg device_;
+  std::unique_ptr<cuda::DeviceDdpg> device_;
   int params_per_sample_ = ddpg_.output_width() - ddpg_.num_actions();
   int64_t actor_steps_ = 0;
   int64_t critic_steps_ = 0;
@@ -130,15 +194,16 @@ std::unique_ptr<UpdateBackend> make_cuda_update_backend(Ddpg& ddpg) {
 }
 
 int cuda_device_count(std::string* why) {
-  return cuda::device_count(why);
+  const cuda::CudaApi* a = cuda::cuda_api(why);
+  return a == nullptr ? 0 : a->device_count(why);
 }
 
 std::string cuda_device_description() {
-  return cuda::device_description();
+  return api().device_description();
 }
 
 double time_device_sgemm(int m, int n, int k, int reps) {
-  return cuda::time_sgemm(m, n, k, reps);
+  return api().time_sgemm(m, n, k, reps);
 }
 
 }  // namespace pamdp

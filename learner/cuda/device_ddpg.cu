@@ -391,11 +391,9 @@ struct Pass {
   }
 };
 
-}  // namespace
-
 // ---------------------------------------------------------------------------------------------
 
-struct DeviceDdpg::Impl {
+struct Impl {
   DeviceDdpgConfig c;
   int B;
   // A stream with its own cuBLAS handle and workspace. Lane 0 runs the update; inside the graph
@@ -452,6 +450,18 @@ struct DeviceDdpg::Impl {
         pass_target_critic(config.critic_widths, config.batch),
         pass_critic(config.critic_widths, config.batch),
         pass_actor(config.actor_widths, config.batch) {
+    try {
+      build();
+    } catch (...) {
+      release();  // the destructor does not run when the constructor throws
+      throw;
+    }
+  }
+
+  ~Impl() { release(); }
+
+  // The constructor's work after the member initializers (which only allocate device arrays).
+  void build() {
     const int obs = c.obs_dim;
     const int w = c.width;
     actor_in = DeviceArray<float>(int64_t{obs + 1} * B);
@@ -544,7 +554,8 @@ struct DeviceDdpg::Impl {
     }
   }
 
-  ~Impl() {
+  // Waits for queued work and destroys every stream, handle, event and graph that exists.
+  void release() noexcept {
     for (Lane& lane : lanes) {
       if (lane.stream != nullptr) {
         cudaStreamSynchronize(lane.stream);
@@ -746,7 +757,24 @@ struct DeviceDdpg::Impl {
   }
 };
 
-DeviceDdpg::DeviceDdpg(const DeviceDdpgConfig& config) {
+// DeviceDdpg, the interface the host side sees, over Impl.
+class DeviceDdpgImpl final : public DeviceDdpg {
+ public:
+  explicit DeviceDdpgImpl(const DeviceDdpgConfig& config);
+  [[nodiscard]] int64_t actor_params() const override;
+  [[nodiscard]] int64_t critic_params() const override;
+  void upload(const HostState& state) override;
+  void download(const HostState& state) override;
+  void download_actor(float* actor) override;
+  DeviceStats enqueue(const HostBatch& batch, float actor_step_size, float critic_step_size,
+                      bool* has_previous) override;
+  DeviceStats finish() override;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+DeviceDdpgImpl::DeviceDdpgImpl(const DeviceDdpgConfig& config) {
   if (config.batch < 1 || config.obs_dim < 1 || config.width < 1 ||
       config.lo.size() != static_cast<size_t>(config.width) || config.hi.size() != static_cast<size_t>(config.width) ||
       config.actor_widths.size() < 2 || config.critic_widths.size() < 2 ||
@@ -758,16 +786,14 @@ DeviceDdpg::DeviceDdpg(const DeviceDdpgConfig& config) {
   impl_ = std::make_unique<Impl>(config);
 }
 
-DeviceDdpg::~DeviceDdpg() = default;
-
-int64_t DeviceDdpg::actor_params() const {
+int64_t DeviceDdpgImpl::actor_params() const {
   return impl_->actor.n;
 }
-int64_t DeviceDdpg::critic_params() const {
+int64_t DeviceDdpgImpl::critic_params() const {
   return impl_->critic.n;
 }
 
-void DeviceDdpg::upload(const HostState& s) {
+void DeviceDdpgImpl::upload(const HostState& s) {
   Impl& d = *impl_;
   check(cudaStreamSynchronize(d.stream), "cudaStreamSynchronize");
   d.copy_in(s.actor, d.actor.params);
@@ -781,7 +807,7 @@ void DeviceDdpg::upload(const HostState& s) {
   check(cudaStreamSynchronize(d.stream), "upload");
 }
 
-void DeviceDdpg::download(const HostState& s) {
+void DeviceDdpgImpl::download(const HostState& s) {
   Impl& d = *impl_;
   check(cudaStreamSynchronize(d.stream), "cudaStreamSynchronize");
   d.copy_out(d.actor.params, s.actor);
@@ -795,14 +821,15 @@ void DeviceDdpg::download(const HostState& s) {
   check(cudaStreamSynchronize(d.stream), "download");
 }
 
-void DeviceDdpg::download_actor(float* actor) {
+void DeviceDdpgImpl::download_actor(float* actor) {
   Impl& d = *impl_;
   check(cudaStreamSynchronize(d.stream), "cudaStreamSynchronize");
   d.copy_out(d.actor.params, actor);
   check(cudaStreamSynchronize(d.stream), "download_actor");
 }
 
-DeviceStats DeviceDdpg::enqueue(const HostBatch& b, float actor_step_size, float critic_step_size, bool* has_previous) {
+DeviceStats DeviceDdpgImpl::enqueue(const HostBatch& b, float actor_step_size, float critic_step_size,
+                                    bool* has_previous) {
   Impl& d = *impl_;
   Impl::Slot& s = d.slots[d.next];
   const int obs = d.c.obs_dim;
@@ -846,7 +873,7 @@ DeviceStats DeviceDdpg::enqueue(const HostBatch& b, float actor_step_size, float
   return out;
 }
 
-DeviceStats DeviceDdpg::finish() {
+DeviceStats DeviceDdpgImpl::finish() {
   Impl& d = *impl_;
   check(cudaStreamSynchronize(d.stream), "cudaStreamSynchronize");
   return d.newest < 0 ? DeviceStats{} : d.stats_of(d.slots[d.newest]);
@@ -933,4 +960,14 @@ double time_sgemm(int m, int n, int k, int reps) {
   return seconds;
 }
 
+std::unique_ptr<DeviceDdpg> create(const DeviceDdpgConfig& config) {
+  return std::make_unique<DeviceDdpgImpl>(config);
+}
+
+}  // namespace
 }  // namespace pamdp::cuda
+
+// The module's one exported symbol (see cuda_api() in device_ddpg.hpp).
+extern "C" const pamdp::cuda::CudaApi pamdp_cuda_api = {pamdp::cuda::kCudaApiVersion, &pamdp::cuda::device_count,
+                                                        &pamdp::cuda::device_description, &pamdp::cuda::time_sgemm,
+                                                        &pamdp::cuda::create};

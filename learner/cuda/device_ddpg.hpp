@@ -1,6 +1,7 @@
 // The DDPG update on a CUDA device, behind a plain C++ interface: this header includes no CUDA
-// or Eigen header (device_ddpg.cu holds every kernel and cuBLAS call), so the glue in
-// cuda_update_backend.cpp and the rest of the project never see CUDA types.
+// or Eigen header (device_ddpg.cu, built as the module libpamdp_cuda.so, holds every kernel and
+// cuBLAS call), so the glue in cuda_update_backend.cpp and the rest of the project never see
+// CUDA types and do not link CUDA.
 //
 // The device keeps both networks, both targets, both Adam states and every scratch buffer in
 // Ddpg's flat layout (core/mlp.hpp: per layer W as out x in column-major, then b), so state
@@ -70,41 +71,50 @@ struct DeviceStats {
   float params_at_bound = 0.0F;  // count of continuous outputs at or past a bound (exact below 2^24)
 };
 
+// Implemented in libpamdp_cuda.so (device_ddpg.cu); the host side holds it through this
+// interface only, so that only a process that asks for the GPU loads CUDA and cuBLAS (loading
+// cuBLAS costs ~0.3 s and ~200 MB per process: actors, shards and `pamdp sim` must not pay it).
 class DeviceDdpg {
  public:
-  // Allocates everything on device 0, runs one warm-up update on zeros (so that cuBLAS and the
-  // kernels are loaded before capture) and captures the two graphs. The parameters are
-  // undefined until upload().
-  explicit DeviceDdpg(const DeviceDdpgConfig& config);
-  ~DeviceDdpg();
-  DeviceDdpg(const DeviceDdpg&) = delete;
-  DeviceDdpg& operator=(const DeviceDdpg&) = delete;
+  virtual ~DeviceDdpg() = default;
 
-  [[nodiscard]] int64_t actor_params() const;
-  [[nodiscard]] int64_t critic_params() const;
+  [[nodiscard]] virtual int64_t actor_params() const = 0;
+  [[nodiscard]] virtual int64_t critic_params() const = 0;
 
   // Wait for queued updates, then copy all state in or out (synchronous; ~40 MB each way at
   // the paper's widths).
-  void upload(const HostState& state);
-  void download(const HostState& state);
+  virtual void upload(const HostState& state) = 0;
+  virtual void download(const HostState& state) = 0;
   // Waits for queued updates, then copies the online actor's parameters out.
-  void download_actor(float* actor);
+  virtual void download_actor(float* actor) = 0;
 
   // Copies the batch into a pinned buffer, queues its transfer and the update's graph with
   // the two Adam step sizes of this update, and returns the statistics of the previous update
   // (zeros if none). `has_previous` tells whether there was one.
-  DeviceStats enqueue(const HostBatch& batch, float actor_step_size, float critic_step_size, bool* has_previous);
+  virtual DeviceStats enqueue(const HostBatch& batch, float actor_step_size, float critic_step_size,
+                              bool* has_previous) = 0;
   // Waits for every queued update; returns the newest one's statistics (zeros if none).
-  DeviceStats finish();
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  virtual DeviceStats finish() = 0;
 };
 
-// Usable devices; on 0, `why` (if given) gets the reason.
-int device_count(std::string* why);
-std::string device_description();
-double time_sgemm(int m, int n, int k, int reps);
+// The module's entry points, exported as one table named `pamdp_cuda_api`.
+constexpr int kCudaApiVersion = 1;
+struct CudaApi {
+  int version;
+  // Usable devices; on 0, `why` (if given) gets the reason.
+  int (*device_count)(std::string* why);
+  std::string (*device_description)();
+  // Seconds that `reps` SGEMMs take (see time_device_sgemm in cuda_update_backend.hpp).
+  double (*time_sgemm)(int m, int n, int k, int reps);
+  // Allocates everything on device 0, runs one warm-up update on zeros (so that cuBLAS and the
+  // kernels are loaded before capture) and captures the two graphs. The parameters are
+  // undefined until upload(). Throws std::runtime_error on CUDA or cuBLAS errors.
+  std::unique_ptr<DeviceDdpg> (*create)(const DeviceDdpgConfig& config);
+};
+
+// Loads libpamdp_cuda.so once (from the running executable's directory, else through the
+// dynamic loader's search path) and returns its table, or nullptr with the reason in *why.
+// Thread-safe; the module stays loaded for the life of the process.
+const CudaApi* cuda_api(std::string* why);
 
 }  // namespace pamdp::cuda
