@@ -189,6 +189,7 @@ void run_learner(const LearnerCliOptions& o) {
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration);
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
       have_eval = true;
+      learner_metrics.on_eval(last_eval);
       if (best.offer(last_eval, ddpg.updates())) {
         CheckpointMeta best_meta = meta;
         best_meta.elapsed_seconds = elapsed();

@@ -200,9 +200,24 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
 
 // ---------------------------------------------------------------------------------------------
 
+EvalMetrics::EvalMetrics(Registry& r)
+    : evals_(r.counter("pamdp_evaluations_total", "Greedy evaluations run (train.eval_every_updates)")),
+      goal_rate_(r.gauge("pamdp_eval_goal_rate", "Success rate of the latest greedy evaluation")),
+      steps_to_goal_(
+          r.gauge("pamdp_eval_steps_to_goal_mean", "Average steps to success of the latest greedy evaluation")),
+      return_mean_(r.gauge("pamdp_eval_return_mean", "Mean return of the latest greedy evaluation")) {}
+
+void EvalMetrics::add(const EvalResult& e) {
+  evals_.add(1);
+  goal_rate_.set(e.goal_rate);
+  steps_to_goal_.set(e.avg_steps_to_goal);
+  return_mean_.set(e.avg_return);
+}
+
 LearnerMetrics::LearnerMetrics(Registry& r, const Env& env, const ExplorationConfig& exploration)
     : exploration_(exploration),
       updates_(r),
+      evals_(r),
       episodes_(r, "pamdp_cluster_", env),
       samples_(r.counter("pamdp_learner_samples_received_total", "Sampled transitions received from the shards")),
       bad_(r.counter("pamdp_bad_messages_total", "Received messages dropped as malformed")),
@@ -233,6 +248,7 @@ void LearnerMetrics::on_tick(const LearnerCounters& c, int64_t updates_total, si
 TrainMetrics::TrainMetrics(Registry& r, const Env& env, int64_t replay_capacity)
     : episodes_(r, "pamdp_", env),
       updates_(r),
+      evals_(r),
       env_steps_(r.counter("pamdp_env_steps_total", "Env steps taken")),
       epsilon_(r.gauge("pamdp_epsilon", "Exploration epsilon of the newest step")),
       inserted_(r.counter("pamdp_replay_transitions_inserted_total", "Transitions stored")),

@@ -23,6 +23,7 @@
 #include "core/metrics_http.hpp"
 #include "envs/env.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/evaluation.hpp"
 #include "learner/learner_server.hpp"
 #include "replay/shard_server.hpp"
 
@@ -74,6 +75,19 @@ class EpisodeMetrics {
 };
 
 // DDPG updates (learner and train).
+// The periodic greedy evaluation (train.eval_every_updates): its latest result and how many ran.
+class EvalMetrics {
+ public:
+  explicit EvalMetrics(metrics::Registry& r);
+  void add(const EvalResult& e);
+
+ private:
+  metrics::Counter& evals_;
+  metrics::Gauge& goal_rate_;
+  metrics::Gauge& steps_to_goal_;
+  metrics::Gauge& return_mean_;
+};
+
 class UpdateMetrics {
  public:
   explicit UpdateMetrics(metrics::Registry& r);
@@ -107,10 +121,12 @@ class LearnerMetrics {
   void on_update(const UpdateStats& s, int64_t updates_total) { updates_.add(s, updates_total); }
   void on_episode(const EpisodeSummary& e) { episodes_.add(e.status, e.ret, static_cast<int>(e.steps)); }
   void on_tick(const LearnerCounters& c, int64_t updates_total, size_t metrics_urls);
+  void on_eval(const EvalResult& e) { evals_.add(e); }
 
  private:
   ExplorationConfig exploration_;
   UpdateMetrics updates_;
+  EvalMetrics evals_;
   EpisodeMetrics episodes_;
   metrics::Counter& samples_;
   metrics::Counter& bad_;
@@ -137,10 +153,12 @@ class TrainMetrics {
   }
   // After the episode's transitions went into the replay buffer.
   void on_episode(int status, double ret, int steps, int64_t replay_size);
+  void on_eval(const EvalResult& e) { evals_.add(e); }
 
  private:
   EpisodeMetrics episodes_;
   UpdateMetrics updates_;
+  EvalMetrics evals_;
   metrics::Counter& env_steps_;
   metrics::Gauge& epsilon_;
   metrics::Counter& inserted_;

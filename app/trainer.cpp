@@ -211,6 +211,9 @@ void Trainer::run_eval() {
   GreedyActorPolicy policy(ddpg_, space_, exploration_);
   last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, mix(c_.seed, 1000 + ddpg_.updates()));
   have_eval_ = true;
+  if (o_.metrics != nullptr) {
+    o_.metrics->on_eval(last_eval_);
+  }
   if (best_ && best_->offer(last_eval_, ddpg_.updates())) {
     save_best();
   }
