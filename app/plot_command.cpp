@@ -165,13 +165,13 @@ void run_plot(const PlotOptions& o) {
       g << (r ? ", " : "") << file << " using 1:" << column << " with lines lw 2 lc " << r + 1 << " title "
         << quoted(runs[r].label);
       if (with_eval && any_eval) {
-        g << ", " << file << " using 1:6 with points pt 7 ps 0.6 lc " << r + 1 << " title "
-          << quoted(runs[r].label + " (greedy eval)");
+        g << ", " << file << " using 1:6 with points pt 7 ps 0.6 lc " << r + 1 << " notitle";
       }
     }
     g << "\nunset logscale y\nset autoscale y\n";
   };
-  panel("goal rate (last 100 episodes)", 2, "set yrange [0:1.05]\n", true);
+  panel(any_eval ? "goal rate (lines: last 100 episodes; points: greedy evaluations)" : "goal rate (last 100 episodes)",
+        2, "set yrange [0:1.05]\n", true);
   panel("mean episode return (last 100)", 3, "", false);
   panel("mean Q (sampled batch)", 4, "", false);
   panel("critic loss", 5, "set logscale y\nset format y '%g'\n", false);
