@@ -62,15 +62,21 @@ done
 mapfile -t urls <"$urls_file"
 echo "metrics URLs: ${urls[*]}"
 for u in "${urls[@]}"; do
-  curl -sf --max-time 2 "$u" | grep -q '^pamdp_process_info{role="' || fail "$u does not serve pamdp metrics"
+  # The body first: `curl | grep -q` fails under pipefail when grep exits before curl's last write.
+  body=$(curl -sf --max-time 2 "$u") || fail "$u does not answer"
+  grep -q '^pamdp_process_info{role="' <<<"$body" || fail "$u does not serve pamdp metrics"
 done
 
 if [[ $mode == monitor ]]; then
-  sleep 1
-  json=$("$bin" monitor --join "$join" --once --json | tail -n 1)
-  echo "monitor --json: ${json:0:600}..."
   # A top-level number (or null) of the JSON line: the first "key":number match.
   field() { grep -o "\"$1\":\(-\?[0-9][0-9.eE+-]*\|null\)" <<<"$json" | head -n1 | cut -d: -f2; }
+  # Until the cluster is past warm-up (on a loaded machine the first interval may see no steps).
+  for _ in $(seq 20); do
+    sleep 1
+    json=$("$bin" monitor --join "$join" --once --json | tail -n 1)
+    awk -v s="$(field env_steps_per_s)" -v u="$(field updates)" 'BEGIN { exit !(s > 0 && u > 0) }' && break
+  done
+  echo "monitor --json: ${json:0:600}..."
   [[ $(field targets) == 4 && $(field up) == 4 ]] || fail "monitor sees $(field up)/$(field targets) targets up"
   [[ $(field actors_alive) == 2 ]] || fail "monitor counts $(field actors_alive) actors alive"
   grep -q '"roles":{"actor":2,"learner":1,"replay":1}' <<<"$json" || fail "monitor roles wrong"
