@@ -37,7 +37,7 @@ struct ActorCliOptions {
   bool apex_epsilon = false;
   std::string name;
   std::string curve_keys;
-  double join_timeout_s = 0.0;
+  double join_timeout_s = 30.0;
   double progress_every_s = 5.0;
   std::string metrics_bind = "127.0.0.1";
   int metrics_port = 0;
@@ -77,8 +77,9 @@ void run_actor(const ActorCliOptions& o) {
       return;
     }
     throw std::runtime_error("no cluster map from the learner at " + o.join + " within " +
-                             std::to_string(o.join_timeout_s) +
-                             " s; start `pamdp learner` first or check the address (--join tcp://HOST:PORT)");
+                             std::to_string(link_config.join_timeout_ms) +
+                             " ms; start `pamdp learner` first or check the address (--join tcp://HOST:PORT), or wait "
+                             "longer with --join-timeout");
   }
   const ExperimentConfig config = parse_experiment_config(map->config_toml, "the cluster map from " + o.join, {});
 
@@ -152,8 +153,9 @@ void register_actor(CLI::App& app) {
   cmd->add_option("--curve-keys", o->curve_keys,
                   "directory with client.keys from pamdp keygen: CURVE on every connection (the learner must run "
                   "with cluster.curve = true)");
-  cmd->add_option("--join-timeout", o->join_timeout_s, "give up joining after this many seconds (0: keep trying)")
-      ->check(CLI::NonNegativeNumber)
+  cmd->add_option("--join-timeout", o->join_timeout_s,
+                  "exit with an error if the learner has not answered within this many seconds (0: keep trying)")
+      ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
   cmd->add_option("--progress-every", o->progress_every_s, "seconds between progress lines")
       ->check(CLI::PositiveNumber)

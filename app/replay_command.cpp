@@ -37,6 +37,8 @@ struct ReplayCliOptions {
   std::string sample_bind = "tcp://*:0";
   std::string advertise_host = "127.0.0.1";
   std::string snapshot;
+  double snapshot_every_s = 0.0;
+  double join_timeout_s = 30.0;
   std::string name;
   std::string curve_keys;
   std::string metrics_bind = "127.0.0.1";
@@ -58,6 +60,8 @@ void run_replay(const ReplayCliOptions& o) {
   options.sample_bind = o.sample_bind;
   options.advertise_host = o.advertise_host;
   options.snapshot_path = o.snapshot;
+  options.snapshot_every_ms = static_cast<int>(o.snapshot_every_s * 1000.0);
+  options.join_timeout_ms = static_cast<int>(o.join_timeout_s * 1000.0);
   options.name = o.name.empty() ? default_name() : o.name;
 
   net::Context ctx;
@@ -149,6 +153,15 @@ void register_replay(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--snapshot", o->snapshot,
                   "replay snapshot file: loaded when the shard starts (if present), written when it stops");
+  cmd->add_option("--snapshot-every", o->snapshot_every_s,
+                  "also write the snapshot every this many seconds (0: only when stopping; a shard killed with "
+                  "SIGKILL keeps what the last write held)")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  cmd->add_option("--join-timeout", o->join_timeout_s,
+                  "exit with an error if the learner has not answered within this many seconds (0: keep trying)")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
   cmd->add_option("--name", o->name, "name in the learner's logs (default replay@HOST:PID)");
   cmd->add_option("--curve-keys", o->curve_keys,
                   "directory written by pamdp keygen: encrypt and authenticate every socket with CURVE "

@@ -13,8 +13,31 @@
 namespace pamdp {
 namespace {
 
+// The FlatBuffers verifier proves a checkpoint safe to read, not unchanged: a flipped byte in the
+// parameters still verifies. So the file ends with a trailer, the FNV-1a checksum of the buffer
+// and a magic word; files without it (written before the trailer existed) are only verified.
+constexpr char kTrailerMagic[4] = {'P', 'C', 'K', '1'};
+constexpr size_t kTrailerSize = sizeof(uint64_t) + sizeof(kTrailerMagic);
+
 std::vector<uint8_t> read_all(const std::string& path) {
   return read_file_bytes(path);
+}
+
+// The FlatBuffers part of a checkpoint file: all of it, less a trailer whose checksum matches.
+size_t buffer_size(const std::vector<uint8_t>& bytes, const std::string& path) {
+  if (bytes.size() < kTrailerSize ||
+      std::memcmp(bytes.data() + bytes.size() - sizeof(kTrailerMagic), kTrailerMagic, sizeof(kTrailerMagic)) != 0) {
+    return bytes.size();
+  }
+  const size_t size = bytes.size() - kTrailerSize;
+  uint64_t sum = 0;
+  std::memcpy(&sum, bytes.data() + size, sizeof(sum));
+  if (sum != fnv1a64(bytes.data(), size)) {
+    throw std::runtime_error("checkpoint '" + path +
+                             "' is corrupt (checksum mismatch); use an earlier checkpoint (best.ckpt, a copy) or "
+                             "start a new run");
+  }
+  return size;
 }
 
 const wire::Checkpoint* verified(const std::vector<uint8_t>& bytes, const std::string& path) {
@@ -22,7 +45,7 @@ const wire::Checkpoint* verified(const std::vector<uint8_t>& bytes, const std::s
     throw std::runtime_error(
         "'" + path + "' is not a pamdp checkpoint (wrong file identifier); pass a .ckpt file written by pamdp train");
   }
-  flatbuffers::Verifier verifier(bytes.data(), bytes.size(), 64, 1000000, false);
+  flatbuffers::Verifier verifier(bytes.data(), buffer_size(bytes, path), 64, 1000000, false);
   if (!wire::VerifyCheckpointBuffer(verifier)) {
     throw std::runtime_error("checkpoint '" + path +
                              "' is corrupt or truncated (FlatBuffers verification failed); use an earlier checkpoint");
@@ -37,9 +60,11 @@ const wire::Checkpoint* verified(const std::vector<uint8_t>& bytes, const std::s
 
 void copy_into(const flatbuffers::Vector<float>* src, std::span<float> dst, const char* what, const std::string& path) {
   if (src == nullptr || src->size() != dst.size()) {
-    throw std::runtime_error("checkpoint '" + path + "': " + what + " has " + std::to_string(src ? src->size() : 0) +
-                             " values, this learner needs " + std::to_string(dst.size()) +
-                             " (was it written with different network widths or env?)");
+    throw std::runtime_error(
+        "checkpoint '" + path + "': " + what + " has " + std::to_string(src ? src->size() : 0) +
+        " values, this learner needs " + std::to_string(dst.size()) +
+        " (written with other network widths or another env: resume without the --set that changes ddpg.hidden or "
+        "env, or start a new run in another --run-dir)");
   }
   std::memcpy(dst.data(), src->data(), dst.size() * sizeof(float));
 }
@@ -98,7 +123,13 @@ void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& 
   b.add_elapsed_seconds(meta.elapsed_seconds);
   b.add_update_credit(meta.update_credit);
   wire::FinishCheckpointBuffer(fbb, b.Finish());
-  write_file_atomically(path, fbb.GetBufferPointer(), fbb.GetSize());
+  const uint64_t sum = fnv1a64(fbb.GetBufferPointer(), fbb.GetSize());
+  uint8_t trailer[kTrailerSize];
+  std::memcpy(trailer, &sum, sizeof(sum));
+  std::memcpy(trailer + sizeof(sum), kTrailerMagic, sizeof(kTrailerMagic));
+  std::vector<uint8_t> file(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
+  file.insert(file.end(), trailer, trailer + kTrailerSize);
+  write_file_atomically(path, file.data(), file.size());
 }
 
 CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {

@@ -221,6 +221,8 @@ void ShardServer::run() {
             insert_endpoint_, sample_endpoint_, options_.join_endpoint);
   last_tick_ = Clock::now();
   next_join_ = last_tick_;
+  next_snapshot_ = last_tick_ + std::chrono::milliseconds(options_.snapshot_every_ms);
+  started_ = last_tick_;
   while (!stop_.load(std::memory_order_relaxed)) {
     Clock::time_point now = Clock::now();
     if (inserts_held_) {
@@ -229,6 +231,12 @@ void ShardServer::run() {
     last_tick_ = now;
 
     if (!joined_) {
+      if (options_.join_timeout_ms > 0 && now - started_ >= std::chrono::milliseconds(options_.join_timeout_ms)) {
+        throw std::runtime_error("no answer from the learner at " + options_.join_endpoint + " within " +
+                                 std::to_string(options_.join_timeout_ms) +
+                                 " ms; start `pamdp learner` first or check the address (--join tcp://HOST:PORT), or "
+                                 "wait longer with --join-timeout");
+      }
       if (now >= next_join_) {
         if (log_waiting_.open(now)) {
           log::info("replay shard '{}': waiting for the learner at {} to answer (JoinRequest every {} ms)",
@@ -276,6 +284,10 @@ void ShardServer::run() {
     }
     if (shard_ != nullptr) {
       serve_waiting_requests(Clock::now());
+      if (options_.snapshot_every_ms > 0 && !options_.snapshot_path.empty() && Clock::now() >= next_snapshot_) {
+        shard_->save_snapshot(options_.snapshot_path);
+        next_snapshot_ = Clock::now() + std::chrono::milliseconds(options_.snapshot_every_ms);
+      }
     }
     publish_counters();
   }

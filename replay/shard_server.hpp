@@ -116,6 +116,13 @@ struct ShardServerOptions {
   // Frames above this size make ZeroMQ drop the sender's connection before anything reads them.
   // Fixed at bind time, before the widths are known (a 4096-row HFO batch is 2.1 MB).
   int64_t max_insert_message_bytes = int64_t{8} << 20;
+  // Also write the snapshot every this many ms while serving (0: only when stopping), so that a
+  // shard killed without a chance to stop loses at most this much of its data. The write blocks
+  // the shard's loop for as long as it takes (capacity rows, atomic rename).
+  int snapshot_every_ms = 0;
+  // run() gives up (throws, naming the join endpoint) if the learner has not answered the first
+  // JoinRequest within this many ms; 0: keep trying until stopped.
+  int join_timeout_ms = 0;
   // CURVE (pamdp keygen): server keys for the two bound sockets, client keys for the join
   // connection. Both or neither; the caller runs a net::CurveAuthenticator on the context.
   std::optional<net::CurveServerKeys> curve_server;
@@ -220,6 +227,8 @@ class ShardServer {
   Clock::time_point next_heartbeat_{};
   Clock::time_point last_heard_learner_{};
   Clock::time_point last_tick_{};
+  Clock::time_point next_snapshot_{};
+  Clock::time_point started_{};
   bool inserts_held_ = false;
   Clock::duration blocked_{};
   LogGate log_insert_, log_sample_, log_join_, log_reply_, log_waiting_, log_silent_;

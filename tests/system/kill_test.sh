@@ -1,0 +1,205 @@
+#!/usr/bin/env bash
+# Killed processes on a local cluster (1 learner, 2 replay shards, 2 actors as processes on
+# loopback, toy ReachStop task, small warm-up). Every assertion reads the processes' /metrics
+# (or the run directory's metrics.csv and checkpoint), not their logs:
+#   actor:   kill -9 one actor; the learner keeps updating and counts 1 actor; a restarted actor
+#            rejoins (2 actors) and acts with weights at least as new as the learner's when it started.
+#   shard:   kill -9 one shard (it writes its snapshot every second); the learner keeps updating
+#            from the other and counts 1 shard; the shard restarted on new ports with the same
+#            snapshot holds data it did not insert (size > its own inserts) and is counted again.
+#   learner: kill -9 the learner, restart it with --resume on the same ports; updates and episodes
+#            start from the checkpoint (>= its counters), and the SAME shard and actor processes
+#            reconnect (2 shards, 2 actors, updates increase).
+#   SIGTERM: the learner stops with status 0, leaving checkpoint.ckpt; --resume starts from it.
+# Prints one line per scenario with its counts. Usage: tests/system/kill_test.sh PATH/TO/pamdp SOURCE_DIR
+set -euo pipefail
+bin=${1:?path to pamdp}
+src=$(cd "${2:?source dir}" && pwd)
+work=$(mktemp -d /tmp/pamdp-kill-test.XXXXXX)
+declare -A pid=()
+faults=0
+cleanup() {
+  for p in "${pid[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  if [[ ${keep:-0} == 1 ]]; then echo "kept $work"; else rm -rf "$work"; fi
+}
+trap cleanup EXIT
+fail() {
+  echo "kill_test: FAIL: $*" >&2
+  for f in "$work"/logs/*.log; do echo "--- $f"; tail -n 12 "$f"; done >&2
+  keep=1
+  exit 1
+}
+mkdir -p "$work/logs"
+t0=$(date +%s.%N)
+since() { awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1fs", b - a }'; }
+
+# The value of metric NAME (with LABELS, e.g. role="replay", if given) at URL; empty if unreachable.
+metric() {
+  curl -sf --max-time 2 "$1" 2>/dev/null |
+    awk -v name="$2" -v labels="${3:-}" '$1 == name || (index($1, name "{") == 1 && index($1, labels) > 0) { print $2; exit }' || true
+}
+# Polls (every 0.2 s, up to SECONDS) until the shell condition holds; fails with DESCRIPTION.
+wait_for() {
+  local seconds=$1 what=$2
+  shift 2
+  local deadline=$(($(date +%s) + seconds))
+  until eval "$*"; do
+    (($(date +%s) < deadline)) || fail "$what (not within ${seconds}s)"
+    sleep 0.2
+  done
+}
+ge() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 >= b + 0) }'; }
+gt() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 > b + 0) }'; }
+# The first metrics URL a process logged.
+url_in() {
+  grep -o 'http://127\.0\.0\.1:[0-9]*/metrics' "$1" 2>/dev/null | head -n 1 || true
+}
+
+common=(--set cluster.advertise_host=127.0.0.1 --set cluster.heartbeat_ms=200 --set cluster.peer_timeout_ms=1500
+  --set cluster.publish_every_updates=50 --set train.max_updates=100000000 --set train.eval_every_updates=0
+  --set train.checkpoint_every_seconds=1 --set train.log_every_seconds=0.5 --set replay.warmup=200
+  --set replay.shards=2 --metrics-bind 127.0.0.1 --metrics-port 0)
+start_learner() {  # $1: log name; the rest: --config/--run-dir or --resume and binds
+  local log=$work/logs/$1.log
+  shift
+  "$bin" learner "$@" "${common[@]}" >"$log" 2>&1 &
+  pid[learner]=$!
+  join=""
+  wait_for 30 "the learner did not report its join endpoint" \
+    'join=$(grep -o "join: *tcp://127.0.0.1:[0-9]*" "$log" | head -n1 | grep -o "tcp://.*" || true); [[ -n $join ]]'
+  weights=$(grep -o "weights: *tcp://127.0.0.1:[0-9]*" "$log" | head -n1 | grep -o 'tcp://.*')
+  wait_for 30 "the learner did not list its metrics URL" '[[ -s $work/run/metrics_urls.txt ]]'
+  lurl=$(head -n 1 "$work/run/metrics_urls.txt")
+}
+start_shard() {  # $1: index
+  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 \
+    --snapshot "$work/shard-$1.replay" --snapshot-every 1 >"$work/logs/shard-$1.log" 2>&1 &
+  pid[shard$1]=$!
+  local log=$work/logs/shard-$1.log  # (wait_for's conditions cannot see $1)
+  wait_for 30 "shard $1 did not log its metrics URL" '[[ -n $(url_in "$log") ]]'
+  surl[$1]=$(url_in "$log")
+}
+start_actor() {  # $1: index, $2: log name
+  "$bin" actor --join "$join" --seed $((30 + $1)) >"$work/logs/$2.log" 2>&1 &
+  pid[actor$1]=$!
+  local log=$work/logs/$2.log
+  wait_for 30 "actor $1 did not log its metrics URL" '[[ -n $(url_in "$log") ]]'
+  aurl[$1]=$(url_in "$log")
+}
+declare -A surl=() aurl=()
+updates() { metric "$lurl" pamdp_updates_total; }
+peers() { metric "$lurl" pamdp_learner_peers_connected "role=\"$1\""; }
+# Waits until the learner's updates exceed their value now by N.
+updates_grow() {
+  local from
+  from=$(updates)
+  from=${from:-0}
+  wait_for 30 "$1: learner updates stuck at $(updates) (from $from)" "gt \"\$(updates)\" $((${from%.*} + $2))"
+}
+
+start_learner learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
+  --set cluster.learner_bind=tcp://127.0.0.1:0 --set cluster.weights_bind=tcp://127.0.0.1:0
+start_shard 0
+start_shard 1
+start_actor 0 actor-0
+start_actor 1 actor-1
+wait_for 30 "the cluster did not form (shards $(peers replay), actors $(peers actor))" \
+  '[[ $(peers replay) == 2 && $(peers actor) == 2 ]]'
+wait_for 40 "no updates" 'gt "$(updates)" 100'
+echo "cluster up at $(since): updates $(updates), shards $(peers replay), actors $(peers actor)"
+
+# --- actor ------------------------------------------------------------------------------------
+kill -KILL "${pid[actor0]}"
+wait "${pid[actor0]}" 2>/dev/null || true
+faults=$((faults + 1))
+wait_for 20 "the learner still counts 2 actors after kill -9" '[[ $(peers actor) == 1 ]]'
+updates_grow "actor killed" 100
+version_at_restart=$(metric "$lurl" pamdp_learner_weights_version)
+start_actor 0 actor-0b
+wait_for 20 "the restarted actor was not counted (actors $(peers actor))" '[[ $(peers actor) == 2 ]]'
+wait_for 20 "the restarted actor has weights version $(metric "${aurl[0]}" pamdp_actor_weights_version), the learner was at $version_at_restart" \
+  'ge "$(metric "${aurl[0]}" pamdp_actor_weights_version)" "$version_at_restart"'
+echo "actor: kill -9 -> learner went on (updates $(updates)); restarted actor joined with weights v$(metric "${aurl[0]}" pamdp_actor_weights_version) (learner v$version_at_restart at its start, now v$(metric "$lurl" pamdp_learner_weights_version)) at $(since)"
+
+# --- replay shard -----------------------------------------------------------------------------
+wait_for 20 "shard 1 wrote no snapshot" '[[ -s $work/shard-1.replay ]]'
+sleep_until_snapshot=$(stat -c %Y "$work/shard-1.replay")
+size_before=$(metric "${surl[1]}" pamdp_replay_size_transitions)
+kill -KILL "${pid[shard1]}"
+wait "${pid[shard1]}" 2>/dev/null || true
+faults=$((faults + 1))
+snapshot_bytes=$(stat -c %s "$work/shard-1.replay")
+wait_for 20 "the learner still counts 2 shards after kill -9" '[[ $(peers replay) == 1 ]]'
+updates_grow "shard killed" 100
+start_shard 1
+wait_for 20 "the restarted shard did not take its config" 'gt "$(metric "${surl[1]}" pamdp_replay_capacity_transitions)" 0'
+size_after=$(metric "${surl[1]}" pamdp_replay_size_transitions)
+inserted_after=$(metric "${surl[1]}" pamdp_replay_transitions_inserted_total)
+restored=$((${size_after%.*} - ${inserted_after%.*}))
+((restored > 0)) || fail "the restarted shard holds $size_after transitions, $inserted_after of them its own inserts: nothing came back from the snapshot"
+# The snapshot's row count (replay/replay_snapshot.cpp: a 40-byte header, rows of 2 obs + action +
+# 3 floats, an 8-byte checksum), with the widths the shard logged.
+widths=$(grep -o 'widths [0-9]*/[0-9]*' "$work/logs/shard-1.log" | head -n 1 | grep -o '[0-9]*/[0-9]*')
+snapshot_rows=$(((snapshot_bytes - 48) / ((2 * ${widths%/*} + ${widths#*/} + 3) * 4)))
+# A scrape reads size and inserts one after the other: an insert in between may move them apart
+# by one batch (cluster.actor_batch_transitions, 64 by default).
+((restored <= snapshot_rows && restored + 64 >= snapshot_rows)) ||
+  fail "the restarted shard restored $restored transitions, its snapshot held $snapshot_rows"
+wait_for 20 "the restarted shard was not counted (shards $(peers replay))" '[[ $(peers replay) == 2 ]]'
+updates_grow "shard restarted" 100
+echo "shard: kill -9 with $size_before transitions (snapshot $snapshot_bytes bytes, mtime $sleep_until_snapshot) -> learner went on; restarted shard restored $restored of the snapshot's $snapshot_rows transitions (size $size_after, own inserts $inserted_after), 2 shards again at $(since)"
+
+# --- learner: kill -9, --resume on the same ports ----------------------------------------------
+wait_for 20 "no checkpoint" '[[ -s $work/run/checkpoint.ckpt ]]'
+actor1_version=$(metric "${aurl[1]}" pamdp_actor_weights_version)
+kill -KILL "${pid[learner]}"
+wait "${pid[learner]}" 2>/dev/null || true
+faults=$((faults + 1))
+cp "$work/run/checkpoint.ckpt" "$work/killed.ckpt"
+# The counters the resumed learner must start from, read from the checkpoint with flatc.
+(cd "$work" && flatc --json --strict-json --raw-binary "$src/schemas/checkpoint.fbs" -- killed.ckpt)
+ck_updates=$(grep -o '"updates": *[0-9]*' "$work/killed.json" | grep -o '[0-9]*$' || echo 0)
+ck_episodes=$(grep -o '"episodes": *[0-9]*' "$work/killed.json" | grep -o '[0-9]*$' || echo 0)
+((ck_updates > 0)) || fail "the checkpoint holds no updates"
+old_join=$join
+start_learner learner-resumed --resume "$work/run" \
+  --set "cluster.learner_bind=$old_join" --set "cluster.weights_bind=$weights"
+[[ $join == "$old_join" ]] || fail "the resumed learner is at $join, not $old_join"
+wait_for 30 "the resumed learner did not update" 'gt "$(updates)" 0'
+first=$(updates)
+ge "$first" "$ck_updates" || fail "the resumed learner is at $first updates, the checkpoint had $ck_updates"
+wait_for 30 "the same shards and actors did not reconnect (shards $(peers replay), actors $(peers actor))" \
+  '[[ $(peers replay) == 2 && $(peers actor) == 2 ]]'
+for p in shard0 shard1 actor0 actor1; do
+  kill -0 "${pid[$p]}" 2>/dev/null || fail "$p exited while the learner was away"
+done
+updates_grow "learner resumed" 200
+# Only the resumed learner can have sent the actor other weights since.
+wait_for 20 "actor 1 got no weights from the resumed learner (still v$actor1_version)" \
+  '[[ $(metric "${aurl[1]}" pamdp_actor_weights_version) != "$actor1_version" ]]'
+# metrics.csv: the resumed learner's rows go on from the checkpoint's counters.
+column() {
+  awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i } END { if (c) print $c }' "$work/run/metrics.csv"
+}
+wait_for 10 "metrics.csv has no row from the resumed learner" 'ge "$(column updates)" "$first"'
+csv_episodes=$(column episodes)
+ge "$csv_episodes" "$ck_episodes" || fail "episodes $csv_episodes after resume, the checkpoint had $ck_episodes"
+echo "learner: kill -9 at checkpoint updates $ck_updates, episodes $ck_episodes -> resumed at $first updates, episodes $csv_episodes, same 2 shards + 2 actors back (actor 1 weights v$actor1_version -> v$(metric "${aurl[1]}" pamdp_actor_weights_version)), updates now $(updates) at $(since)"
+
+# --- SIGTERM: a resumable run directory ---------------------------------------------------------
+kill -TERM "${pid[learner]}"
+status=0
+wait "${pid[learner]}" || status=$?
+((status == 0)) || fail "the learner exited with status $status on SIGTERM"
+faults=$((faults + 1))
+[[ -s $work/run/checkpoint.ckpt ]] || fail "no checkpoint.ckpt after SIGTERM"
+(cd "$work" && cp run/checkpoint.ckpt term.ckpt && flatc --json --strict-json --raw-binary "$src/schemas/checkpoint.fbs" -- term.ckpt)
+term_updates=$(grep -o '"updates": *[0-9]*' "$work/term.json" | grep -o '[0-9]*$')
+ge "$term_updates" "$first" || fail "the SIGTERM checkpoint has $term_updates updates, fewer than the run had"
+start_learner learner-term-resumed --resume "$work/run" \
+  --set "cluster.learner_bind=$old_join" --set "cluster.weights_bind=$weights"
+wait_for 30 "the learner resumed after SIGTERM did not update" 'gt "$(updates)" 0'
+ge "$(updates)" "$term_updates" || fail "resumed after SIGTERM at $(updates) updates, the checkpoint had $term_updates"
+echo "SIGTERM: exit 0, checkpoint at $term_updates updates; --resume went on at $(updates) updates at $(since)"
+echo "kill_test: OK: $faults faults injected (3 kill -9, 1 SIGTERM), 0 processes failed to rejoin, in $(since)"
