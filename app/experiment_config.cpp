@@ -1,6 +1,7 @@
 #include "app/experiment_config.hpp"
 
 #include <toml++/toml.h>
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <set>
@@ -361,6 +362,9 @@ void apply_override(toml::table& root, const std::string& assignment) {
     }
   }
   const auto parts = split_path(key);
+  if (parts.empty() || std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
+    throw std::runtime_error("--set '" + assignment + "': expected section.key=value, e.g. --set ddpg.gamma=0.95");
+  }
   toml::table* t = &root;
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     auto [it, inserted] = t->insert(parts[i], toml::table{});

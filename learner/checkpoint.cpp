@@ -154,7 +154,8 @@ CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {
   meta.elapsed_seconds = ck->elapsed_seconds();
   meta.update_credit = ck->update_credit();
   if (const auto* r = ck->rng_states()) {
-    if (r->size() % 4 != 0) {
+    // FlatBuffers 2.0's verifier does not check the alignment of 8-byte elements.
+    if (r->size() % 4 != 0 || reinterpret_cast<uintptr_t>(r->data()) % alignof(uint64_t) != 0) {
       throw std::runtime_error("checkpoint '" + path + "': RNG state is malformed");
     }
     for (flatbuffers::uoffset_t i = 0; i < r->size(); i += 4) {

@@ -55,8 +55,8 @@ void load_replay_snapshot(const std::string& path, ReplayBuffer& buffer) {
                              std::to_string(buffer.obs_dim()) + "/" + std::to_string(buffer.action_dim()));
   }
   const size_t row = 2 * static_cast<size_t>(h.obs_dim) + static_cast<size_t>(h.action_dim) + 3;
-  if (h.size < 0 || h.size > h.capacity) {
-    throw std::runtime_error("replay snapshot '" + path + "' is corrupt (bad size)");
+  if (h.size < 0 || h.size > h.capacity || h.inserted < h.size) {
+    throw std::runtime_error("replay snapshot '" + path + "' is corrupt (bad size or insert count)");
   }
   const size_t payload = static_cast<size_t>(h.size) * row * sizeof(float);
   if (bytes.size() != sizeof(Header) + payload + sizeof(uint64_t)) {
