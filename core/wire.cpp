@@ -51,9 +51,10 @@ const Envelope* open_envelope(std::span<const uint8_t> bytes) {
   }
   // The verifier of our FlatBuffers (2.0) checks a vector's length prefix for alignment, not its
   // elements: a crafted Heartbeat can place its 8-byte counters at an address that is not a
-  // multiple of 8, and reading them would be undefined behaviour (found by fuzz/fuzz_envelope).
+  // multiple of 8, and reading them would be undefined behaviour (found by fuzz/fuzz_envelope). An
+  // empty vector has nothing to read, and builders do not align it.
   if (const Heartbeat* hb = env->payload_as_Heartbeat();
-      hb != nullptr && hb->counters() != nullptr &&
+      hb != nullptr && hb->counters() != nullptr && hb->counters()->size() > 0 &&
       reinterpret_cast<uintptr_t>(hb->counters()->data()) % alignof(int64_t) != 0) {
     return nullptr;
   }
