@@ -20,10 +20,17 @@
 
 namespace {
 
-std::string scratch_path() {
-  const char* dir = std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp";
-  return std::string(dir) + "/pamdp-fuzz-checkpoint-" + std::to_string(getpid()) + ".ckpt";
-}
+// A file of this process's own, removed when the fuzzer exits.
+struct Scratch {
+  std::string path;
+  Scratch() {
+    const char* dir = std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp";
+    path = std::string(dir) + "/pamdp-fuzz-checkpoint-" + std::to_string(getpid()) + ".ckpt";
+  }
+  ~Scratch() { std::remove(path.c_str()); }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+};
 
 struct Learner {
   pamdp::toy::ReachStopEnv env;
@@ -57,7 +64,8 @@ void load(const std::string& path, const uint8_t* data, size_t size, pamdp::Ddpg
 // Each input twice: as it is, and with its last 12 bytes replaced by a right checksum trailer
 // (learner/checkpoint.cpp), so that mutations of the buffer reach the verifier and the loader.
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path = scratch_path();
+  static const Scratch scratch;
+  const std::string& path = scratch.path;
   static Learner learner;
   load(path, data, size, *learner.ddpg);
   constexpr size_t kTrailer = sizeof(uint64_t) + 4;
