@@ -13,7 +13,7 @@ shift || true
 targets=("$@")
 ((${#targets[@]})) || targets=(fuzz_envelope fuzz_transition_batch fuzz_checkpoint fuzz_replay_snapshot fuzz_config)
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is not installed (Debian package clang)" >&2; exit 2; }
-build=build-fuzz
+build="build-fuzz"
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPAMDP_FUZZ=ON \
   -DPAMDP_BUILD_TESTS=OFF -DPAMDP_BUILD_BENCH=OFF -DPAMDP_CUDA=OFF -DPAMDP_NATIVE=OFF >/dev/null
