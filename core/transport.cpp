@@ -1,10 +1,14 @@
 #include "core/transport.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zmq.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -333,16 +337,26 @@ CurveServerKeys generate_curve_keypair() {
 namespace {
 
 void write_secret_file(const std::string& path, const std::string& text) {
-  if (std::filesystem::exists(path)) {
-    throw std::runtime_error("'" + path + "' exists; keys are never overwritten (remove it or choose another --dir)");
+  // Created 0600 and exclusively: never readable by others, not even for a moment, and never
+  // over an existing file.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    if (errno == EEXIST) {
+      throw std::runtime_error("'" + path + "' exists; keys are never overwritten (remove it or choose another --dir)");
+    }
+    throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
   }
-  std::ofstream out(path);
-  if (!out) {
-    throw std::runtime_error("cannot write '" + path + "'");
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n <= 0) {
+      const int err = errno;
+      ::close(fd);
+      throw std::runtime_error("cannot write '" + path + "': " + std::strerror(err));
+    }
+    done += static_cast<size_t>(n);
   }
-  out << text;
-  out.close();
-  ::chmod(path.c_str(), 0600);
+  ::close(fd);
 }
 
 std::map<std::string, std::string> read_key_file(const std::string& path) {
@@ -350,6 +364,15 @@ std::map<std::string, std::string> read_key_file(const std::string& path) {
   if (!in) {
     throw std::runtime_error("cannot read CURVE key file '" + path +
                              "' (create the keys with: pamdp keygen --dir DIR)");
+  }
+  // A secret key every user of the machine can read is no secret: refuse it, as ssh does.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && (st.st_mode & S_IROTH) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof(mode), "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    throw std::runtime_error("CURVE key file '" + path + "' is readable by every user (mode " + mode +
+                             "), so its secret key is exposed: chmod 600 '" + path +
+                             "' (pamdp keygen writes 0600; a Kubernetes secret volume needs defaultMode: 0400)");
   }
   std::map<std::string, std::string> kv;
   std::string line;

@@ -1,16 +1,19 @@
 // core/: Rng, ActionSpace, RandomPolicy; and the FlatBuffers EpisodeReport wire format.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
 #include "core/action_space.hpp"
 #include "core/policy.hpp"
 #include "core/rng.hpp"
+#include "core/transport.hpp"
 #include "schemas/episode_generated.h"
 
 namespace pamdp {
@@ -394,3 +397,33 @@ TEST(EpisodeReport, VerifierRejectsCorruptBuffers) {
 
 }  // namespace
 }  // namespace pamdp
+
+namespace {
+
+// pamdp keygen's files: created 0600, never overwritten, and refused once readable by everyone.
+TEST(CurveKeys, WrittenPrivateRefusedWhenWorldReadable) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / ("pamdp_keys_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  pamdp::net::write_curve_keyring(dir.string());
+  for (const char* name : {"server.keys", "client.keys"}) {
+    const auto perms = fs::status(dir / name).permissions();
+    EXPECT_EQ(perms & (fs::perms::group_all | fs::perms::others_all), fs::perms::none) << name;
+  }
+  EXPECT_NO_THROW(pamdp::net::load_curve_keyring(dir.string(), /*need_server=*/true));
+  EXPECT_THROW(pamdp::net::write_curve_keyring(dir.string()), std::runtime_error);  // never overwrites
+
+  fs::permissions(dir / "client.keys", fs::perms::others_read, fs::perm_options::add);
+  try {
+    pamdp::net::load_curve_keyring(dir.string(), /*need_server=*/false);
+    ADD_FAILURE() << "a world-readable key file was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("readable by every user"), std::string::npos) << what;
+    EXPECT_NE(what.find("chmod 600"), std::string::npos) << what;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
