@@ -1,6 +1,10 @@
 // The metrics registry (core/metrics.hpp) and its HTTP endpoint (core/metrics_http.hpp): the text
 // format, misuse, updates that allocate nothing, and a real scrape over loopback.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <netinet/in.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/experiment_config.hpp"
 #include "app/role_metrics.hpp"
 #include "core/metrics.hpp"
 #include "core/metrics_http.hpp"
@@ -167,6 +172,49 @@ TEST(MetricsHttp, ServesAndFetchesOverLoopback) {
   EXPECT_NE(body->find("pamdp_scrapes_seen_total 100000\n"), std::string::npos);
   EXPECT_FALSE(http_get("http://127.0.0.1:" + std::to_string(server.port()) + "/nothing", 2000, &error));
   EXPECT_NE(error.find("404"), std::string::npos) << error;
+}
+
+// A non-loopback IPv4 address of this machine, or "" when it has none.
+std::string non_loopback_ipv4() {
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) {
+    return "";
+  }
+  std::string found;
+  for (ifaddrs* i = list; i != nullptr && found.empty(); i = i->ifa_next) {
+    if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET || (i->ifa_flags & IFF_LOOPBACK) != 0 ||
+        (i->ifa_flags & IFF_UP) == 0) {
+      continue;
+    }
+    char text[INET_ADDRSTRLEN];
+    const auto* in = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
+    if (inet_ntop(AF_INET, &in->sin_addr, text, sizeof(text)) != nullptr) {
+      found = text;
+    }
+  }
+  freeifaddrs(list);
+  return found;
+}
+
+// The promise of [metrics] bind's default: a process's /metrics is reachable from this machine
+// only, not on its other interfaces, unless configured otherwise.
+TEST(MetricsHttp, DefaultBindIsLoopbackOnly) {
+  const app::ExperimentConfig defaults;
+  EXPECT_EQ(defaults.metrics.bind, "127.0.0.1");
+  const std::string other = non_loopback_ipv4();
+  if (other.empty()) {
+    GTEST_SKIP() << "this machine has no non-loopback IPv4 address to try";
+  }
+  Registry r;
+  r.counter("pamdp_probe_total", "x");
+  MetricsHttpServer server(r, defaults.metrics.bind, 0);
+  std::string error;
+  EXPECT_TRUE(http_get(server.url(), 2000, &error).has_value()) << error;
+  EXPECT_FALSE(http_get("http://" + other + ":" + std::to_string(server.port()) + "/metrics", 2000, &error))
+      << "/metrics answered on " << other;
+  MetricsHttpServer everywhere(r, "0.0.0.0", 0);  // configured otherwise: reachable there too
+  EXPECT_TRUE(http_get("http://" + other + ":" + std::to_string(everywhere.port()) + "/metrics", 2000, &error))
+      << error;
 }
 
 TEST(MetricsHttp, PortInUseIsAnErrorNamingTheFix) {
