@@ -269,7 +269,11 @@ struct JoinInfo {
 
 class FakeLearner {
  public:
-  explicit FakeLearner(net::Context& ctx) : router_(ctx, net::SocketType::kRouter) {
+  explicit FakeLearner(net::Context& ctx, const net::CurveServerKeys* curve = nullptr)
+      : router_(ctx, net::SocketType::kRouter) {
+    if (curve != nullptr) {
+      router_.make_curve_server(*curve);
+    }
     endpoint_ = router_.bind("tcp://127.0.0.1:*");
   }
   [[nodiscard]] const std::string& endpoint() const { return endpoint_; }
@@ -514,6 +518,52 @@ TEST(ShardServer, InsertedTransitionsComeBackExactly) {
   EXPECT_EQ(c.malformed, 0);
   EXPECT_EQ(c.map_version, 1);
   EXPECT_LT(shard.stop().count(), 500);
+  EXPECT_EQ(shard.error(), "");
+}
+
+// With CURVE, the shard's insert and sample sockets take nothing from a client whose key the
+// cluster did not issue, even one that knows the server's public key; the cluster's key works.
+TEST(ShardServer, CurveRefusesForeignKeysOnBothSockets) {
+  const net::CurveServerKeys server = net::generate_curve_keypair();
+  const net::CurveServerKeys cluster_client = net::generate_curve_keypair();
+  const net::CurveServerKeys intruder = net::generate_curve_keypair();
+  const net::CurveClientKeys good{cluster_client.public_key, cluster_client.secret_key, server.public_key};
+  const net::CurveClientKeys bad{intruder.public_key, intruder.secret_key, server.public_key};
+
+  net::Context ctx;
+  net::CurveAuthenticator auth(ctx, {cluster_client.public_key});  // before the sockets
+  FakeLearner learner(ctx, &server);
+  ShardServerOptions o = test_options(learner);
+  o.curve_server = server;
+  o.curve_client = good;
+  RunningShard shard(ctx, o, fixed_config(small_config()));
+  join(learner, shard);
+
+  // Keys are set before connecting (CURVE applies to connections made after it).
+  net::Socket raw_actor(ctx, net::SocketType::kDealer);
+  raw_actor.make_curve_client(bad);
+  raw_actor.connect(shard.server().insert_endpoint());
+  net::Socket raw_sampler(ctx, net::SocketType::kDealer);
+  raw_sampler.make_curve_client(bad);
+  raw_sampler.connect(shard.server().sample_endpoint());
+  flatbuffers::FlatBufferBuilder fbb;
+  const Rows rows = make_rows(5, 1.0F);
+  wire::build_transition_batch(fbb, 9, 0, rows.view());
+  (void)raw_actor.send(wire::bytes_of(fbb), 200);  // queued until a handshake that never succeeds
+  wire::build_sample_request(fbb, 1, 8);
+  (void)raw_sampler.send(wire::bytes_of(fbb), 200);
+  EXPECT_TRUE(eventually([&] { return auth.refused() >= 2; })) << "refused " << auth.refused();
+  net::Message reply;
+  EXPECT_FALSE(raw_sampler.recv(reply, 300)) << "an unauthenticated sampler got an answer";
+  EXPECT_EQ(shard.server().counters().inserted, 0);
+  EXPECT_EQ(shard.server().counters().malformed, 0);
+
+  net::Socket actor(ctx, net::SocketType::kDealer);
+  actor.make_curve_client(good);
+  actor.connect(shard.server().insert_endpoint());
+  wire::build_transition_batch(fbb, 7, 0, rows.view());
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  EXPECT_TRUE(eventually([&] { return shard.server().counters().inserted == 5; }));
   EXPECT_EQ(shard.error(), "");
 }
 
