@@ -81,6 +81,10 @@ t1=$(column wall_seconds)
 net=$(awk -v a="$u0" -v b="$u1" -v s="$t0" -v e="$t1" 'BEGIN { printf "%.1f", (b - a) / (e - s) }')
 
 batch=$(awk -F= '/^batch_size/ { gsub(/ /, "", $2); print $2 }' "$work/run/config.toml")
+# The cluster stops before the in-process measurement, which needs the core to itself.
+for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+wait 2>/dev/null || true
+pids=()
 inproc=$("$bench" --benchmark_filter="^BM_DdpgUpdate/${batch}\$" --benchmark_min_time=5 --benchmark_format=csv 2>/dev/null |
   awk -F, '/^name,/ { for (i = 1; i <= NF; i++) if ($i == "items_per_second") c = i; next }
     /BM_DdpgUpdate/ && c { print $c }' || true)
