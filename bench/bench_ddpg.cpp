@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/rng.hpp"
+#include "bench/random_batch.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/ddpg.hpp"
 
@@ -22,29 +22,8 @@ void BM_DdpgUpdate(benchmark::State& state) {
   cfg.bound = pamdp::BoundMethod::kInverting;
   const pamdp::ActionSpace& space = pamdp::hfo::hfo_action_space();
   pamdp::Ddpg ddpg(58, space, cfg, 1);
-  pamdp::Rng rng(2);
-  auto random = [&](int rows, int cols, float lo, float hi) {
-    Eigen::MatrixXf m(rows, cols);
-    for (Eigen::Index i = 0; i < m.size(); ++i) {
-      m.data()[i] = static_cast<float>(rng.uniform(lo, hi));
-    }
-    return m;
-  };
-  const Eigen::MatrixXf states = random(58, batch, -1, 1);
-  const Eigen::MatrixXf next_states = random(58, batch, -1, 1);
-  Eigen::MatrixXf actions = random(10, batch, -1, 1);
-  actions.bottomRows(6) *= 100.0F;
-  const Eigen::VectorXf rewards = random(batch, 1, -0.1F, 0.1F);
-  const Eigen::VectorXf terminal = Eigen::VectorXf::Zero(batch);
-  const Eigen::VectorXf returns = Eigen::VectorXf::Zero(batch);
-  const pamdp::BatchView view{
-      Eigen::Map<const Eigen::MatrixXf>(states.data(), 58, batch),
-      Eigen::Map<const Eigen::MatrixXf>(actions.data(), 10, batch),
-      Eigen::Map<const Eigen::VectorXf>(rewards.data(), batch),
-      Eigen::Map<const Eigen::MatrixXf>(next_states.data(), 58, batch),
-      Eigen::Map<const Eigen::VectorXf>(terminal.data(), batch),
-      Eigen::Map<const Eigen::VectorXf>(returns.data(), batch),
-  };
+  const pamdp::bench::RandomHfoBatch data(batch);
+  const pamdp::BatchView view = data.view();
   for (auto _ : state) {
     const pamdp::UpdateStats s = ddpg.update(view);
     benchmark::DoNotOptimize(s.critic_loss);
