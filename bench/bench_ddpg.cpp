@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "bench/random_batch.hpp"
+#include "bench/update_bench.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/ddpg.hpp"
 
@@ -29,22 +29,7 @@ void BM_DdpgUpdate(benchmark::State& state) {
     benchmark::DoNotOptimize(s.critic_loss);
   }
   state.SetItemsProcessed(state.iterations());
-  // FLOP of one update: forward 2*MACs per sample; target actor, target critic, critic,
-  // actor and critic again forward; critic backward (params + input) ~2x forward, critic
-  // backward to inputs only ~1x, actor backward (params) ~1x (no input gradient).
-  auto macs = [](const std::vector<int>& w) {
-    double m = 0;
-    for (size_t i = 0; i + 1 < w.size(); ++i) {
-      m += static_cast<double>(w[i]) * w[i + 1];
-    }
-    return m;
-  };
-  const double a = 2.0 * macs(ddpg.actor().widths()) * batch;
-  const double c = 2.0 * macs(ddpg.critic().widths()) * batch;
-  const double flop = (2 * a + 3 * c) + 2 * c + 1 * c + 1 * a;
-  state.counters["GFLOP_per_update"] = flop / 1e9;
-  state.counters["GFLOP/s"] =
-      benchmark::Counter(flop * static_cast<double>(state.iterations()) / 1e9, benchmark::Counter::kIsRate);
+  pamdp::bench::report_update_flop(state, ddpg, batch);
 }
 BENCHMARK(BM_DdpgUpdate)->Arg(32)->Arg(128)->Arg(1024)->Unit(benchmark::kMillisecond);
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/random_batch.hpp"
+#include "bench/update_bench.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/cuda/cuda_update_backend.hpp"
 #include "learner/ddpg.hpp"
@@ -52,20 +52,7 @@ void BM_DdpgUpdateCuda(benchmark::State& state) {
   }
   backend->finish();
   state.SetItemsProcessed(state.iterations());
-  // FLOP of one update, counted as in BM_DdpgUpdate.
-  auto macs = [](const std::vector<int>& w) {
-    double m = 0;
-    for (size_t i = 0; i + 1 < w.size(); ++i) {
-      m += static_cast<double>(w[i]) * w[i + 1];
-    }
-    return m;
-  };
-  const double a = 2.0 * macs(ddpg.actor().widths()) * batch;
-  const double c = 2.0 * macs(ddpg.critic().widths()) * batch;
-  const double flop = (2 * a + 3 * c) + 2 * c + 1 * c + 1 * a;
-  state.counters["GFLOP_per_update"] = flop / 1e9;
-  state.counters["GFLOP/s"] =
-      benchmark::Counter(flop * static_cast<double>(state.iterations()) / 1e9, benchmark::Counter::kIsRate);
+  pamdp::bench::report_update_flop(state, ddpg, batch);
   state.SetLabel(pamdp::cuda_device_description());
 }
 BENCHMARK(BM_DdpgUpdateCuda)->Arg(32)->Arg(128)->Arg(1024)->Unit(benchmark::kMicrosecond);
