@@ -16,21 +16,10 @@
 
 #include "core/files.hpp"
 #include "envs/toy/reach_stop.hpp"
+#include "fuzz/scratch_file.hpp"
 #include "learner/checkpoint.hpp"
 
 namespace {
-
-// A file of this process's own, removed when the fuzzer exits.
-struct Scratch {
-  std::string path;
-  Scratch() {
-    const char* dir = std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp";
-    path = std::string(dir) + "/pamdp-fuzz-checkpoint-" + std::to_string(getpid()) + ".ckpt";
-  }
-  ~Scratch() { std::remove(path.c_str()); }
-  Scratch(const Scratch&) = delete;
-  Scratch& operator=(const Scratch&) = delete;
-};
 
 struct Learner {
   pamdp::toy::ReachStopEnv env;
@@ -64,7 +53,7 @@ void load(const std::string& path, const uint8_t* data, size_t size, pamdp::Ddpg
 // Each input twice: as it is, and with its last 12 bytes replaced by a right checksum trailer
 // (learner/checkpoint.cpp), so that mutations of the buffer reach the verifier and the loader.
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const Scratch scratch;
+  static const pamdp::fuzz::ScratchFile scratch("checkpoint", ".ckpt");
   const std::string& path = scratch.path;
   static Learner learner;
   load(path, data, size, *learner.ddpg);

@@ -14,21 +14,10 @@
 #include <vector>
 
 #include "core/files.hpp"
+#include "fuzz/scratch_file.hpp"
 #include "replay/replay_snapshot.hpp"
 
 namespace {
-
-// A file of this process's own, removed when the fuzzer exits.
-struct Scratch {
-  std::string path;
-  Scratch() {
-    const char* dir = std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp";
-    path = std::string(dir) + "/pamdp-fuzz-snapshot-" + std::to_string(getpid()) + ".replay";
-  }
-  ~Scratch() { std::remove(path.c_str()); }
-  Scratch(const Scratch&) = delete;
-  Scratch& operator=(const Scratch&) = delete;
-};
 
 void load(const std::string& path, const uint8_t* data, size_t size, pamdp::ReplayBuffer& buffer) {
   if (FILE* f = std::fopen(path.c_str(), "wb")) {
@@ -48,7 +37,7 @@ void load(const std::string& path, const uint8_t* data, size_t size, pamdp::Repl
 // Each input twice: as it is, and with its last 8 bytes replaced by the right checksum, so that
 // mutations of the header and rows reach the checks after the checksum (a forged or buggy file).
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const Scratch scratch;
+  static const pamdp::fuzz::ScratchFile scratch("snapshot", ".replay");
   const std::string& path = scratch.path;
   static pamdp::ReplayBuffer buffer(64, 3, 4);
   load(path, data, size, buffer);
