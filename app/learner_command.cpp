@@ -18,6 +18,7 @@
 #include "app/experiment_config.hpp"
 #include "app/role_metrics.hpp"
 #include "app/run_logs.hpp"
+#include "app/run_options.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
@@ -39,16 +40,7 @@ extern "C" void on_learner_signal(int /*sig*/) {
   }
 }
 
-struct LearnerCliOptions {
-  std::string config;
-  std::vector<std::string> sets;
-  int64_t seed = -1;
-  std::string run_dir;
-  std::string resume;
-  bool quiet = false;
-  std::string metrics_bind;  // overrides metrics.bind when set
-  int metrics_port = -1;     // overrides metrics.port when >= 0
-};
+using LearnerCliOptions = RunCliOptions;
 
 void run_learner(const LearnerCliOptions& o) {
   ExperimentConfig c;
@@ -106,12 +98,7 @@ void run_learner(const LearnerCliOptions& o) {
   sc.peer_timeout_ms = c.cluster.peer_timeout_ms;
   sc.max_updates = c.train.max_updates;
   sc.max_seconds = c.train.max_seconds;
-  if (!o.metrics_bind.empty()) {
-    c.metrics.bind = o.metrics_bind;
-  }
-  if (o.metrics_port >= 0) {
-    c.metrics.port = o.metrics_port;
-  }
+  o.apply_metrics_overrides(c);
   MetricsEndpoint endpoint("learner", "learner", c.metrics.bind, c.metrics.port, c.cluster.advertise_host);
   LearnerMetrics learner_metrics(endpoint.registry(), *env, exploration);
   sc.metrics_url = endpoint.url();
@@ -273,15 +260,10 @@ void register_learner(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("learner",
                                      "the learner of the distributed system: samples replay shards, "
                                      "runs DDPG updates, broadcasts weights");
-  cmd->add_option("--config", o->config, "TOML config (default: the paper preset)");
-  cmd->add_option("--set", o->sets, "override one config key, e.g. --set cluster.learner_bind=tcp://*:6000");
-  cmd->add_option("--seed", o->seed, "random seed (overrides the config's seed)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--run-dir", o->run_dir, "where config, metrics and checkpoints go");
-  cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
-  cmd->add_flag("--quiet", o->quiet, "no progress lines");
-  cmd->add_option("--metrics-bind", o->metrics_bind, "address to serve /metrics on (overrides metrics.bind)");
-  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics, 0 = any free port (overrides metrics.port)")
-      ->check(CLI::Range(0, 65535));
+  add_run_options(*cmd, *o,
+                  {"TOML config (default: the paper preset)",
+                   "override one config key, e.g. --set cluster.learner_bind=tcp://*:6000",
+                   "where config, metrics and checkpoints go"});
   cmd->callback([o] { run_learner(*o); });
 }
 

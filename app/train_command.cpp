@@ -13,6 +13,7 @@
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "app/role_metrics.hpp"
+#include "app/run_options.hpp"
 #include "app/run_support.hpp"
 #include "app/trainer.hpp"
 
@@ -25,16 +26,8 @@ extern "C" void on_signal(int /*sig*/) {
   g_stop.store(true);
 }
 
-struct TrainCliOptions {
-  std::string config;
-  std::vector<std::string> sets;
-  int64_t seed = -1;
-  std::string run_dir;
-  std::string resume;
-  bool quiet = false;
+struct TrainCliOptions : RunCliOptions {
   bool json = false;
-  std::string metrics_bind;  // overrides metrics.bind when set
-  int metrics_port = -1;     // overrides metrics.port when >= 0
 };
 
 void run_train(const TrainCliOptions& o) {
@@ -68,12 +61,7 @@ void run_train(const TrainCliOptions& o) {
   }
   opts.quiet = o.quiet;
   opts.stop = &g_stop;
-  if (!o.metrics_bind.empty()) {
-    config.metrics.bind = o.metrics_bind;
-  }
-  if (o.metrics_port >= 0) {
-    config.metrics.port = o.metrics_port;
-  }
+  o.apply_metrics_overrides(config);
   MetricsEndpoint endpoint("train", opts.run_dir, config.metrics.bind, config.metrics.port, "");
   TrainMetrics train_metrics(endpoint.registry(), *make_env(config.env), config.replay.capacity);
   opts.metrics = &train_metrics;
@@ -107,18 +95,12 @@ void run_train(const TrainCliOptions& o) {
 void register_train(CLI::App& app) {
   auto o = std::make_shared<TrainCliOptions>();
   CLI::App* cmd = app.add_subcommand("train", "train DDPG in one process (env, replay and learner in one thread)");
-  cmd->add_option(
-      "--config", o->config,
-      "TOML config (presets: deploy/configs/paper.toml, fast.toml, reach_stop.toml); default: built-in paper settings");
-  cmd->add_option("--set", o->sets, "override one config key, e.g. --set ddpg.gamma=0.95 (repeatable)");
-  cmd->add_option("--seed", o->seed, "random seed (overrides the config's seed)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--run-dir", o->run_dir, "where config, metrics and checkpoints go (default runs/<time>-seed<S>)");
-  cmd->add_option("--resume", o->resume, "continue the run in this directory from its checkpoint");
-  cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  add_run_options(*cmd, *o,
+                  {"TOML config (presets: deploy/configs/paper.toml, fast.toml, reach_stop.toml); default: built-in "
+                   "paper settings",
+                   "override one config key, e.g. --set ddpg.gamma=0.95 (repeatable)",
+                   "where config, metrics and checkpoints go (default runs/<time>-seed<S>)"});
   cmd->add_flag("--json", o->json, "print one JSON summary object as the last line");
-  cmd->add_option("--metrics-bind", o->metrics_bind, "address to serve /metrics on (overrides metrics.bind)");
-  cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics, 0 = any free port (overrides metrics.port)")
-      ->check(CLI::Range(0, 65535));
   cmd->callback([o] { run_train(*o); });
 }
 
