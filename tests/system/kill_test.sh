@@ -15,93 +15,15 @@
 set -euo pipefail
 bin=${1:?path to pamdp}
 src=$(cd "${2:?source dir}" && pwd)
-work=$(mktemp -d /tmp/pamdp-kill-test.XXXXXX)
-declare -A pid=()
+test_name=kill_test
+# shellcheck source=tests/system/cluster_lib.sh
+source "$src/tests/system/cluster_lib.sh"
 faults=0
-cleanup() {
-  for p in "${pid[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  if [[ ${keep:-0} == 1 ]]; then echo "kept $work"; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
-fail() {
-  echo "kill_test: FAIL: $*" >&2
-  for f in "$work"/logs/*.log; do echo "--- $f"; tail -n 12 "$f"; done >&2
-  keep=1
-  exit 1
-}
-mkdir -p "$work/logs"
-t0=$(date +%s.%N)
-since() { awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1fs", b - a }'; }
-
-# The value of metric NAME (with LABELS, e.g. role="replay", if given) at URL; empty if unreachable.
-metric() {
-  curl -sf --max-time 2 "$1" 2>/dev/null |
-    awk -v name="$2" -v labels="${3:-}" '$1 == name || (index($1, name "{") == 1 && index($1, labels) > 0) { print $2; exit }' || true
-}
-# Polls (every 0.2 s, up to SECONDS) until the shell condition holds; fails with DESCRIPTION.
-wait_for() {
-  local seconds=$1 what=$2
-  shift 2
-  local deadline=$(($(date +%s) + seconds))
-  until eval "$*"; do
-    (($(date +%s) < deadline)) || fail "$what (not within ${seconds}s)"
-    sleep 0.2
-  done
-}
-ge() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 >= b + 0) }'; }
-gt() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 > b + 0) }'; }
-# The first metrics URL a process logged.
-url_in() {
-  grep -o 'http://127\.0\.0\.1:[0-9]*/metrics' "$1" 2>/dev/null | head -n 1 || true
-}
-
-common=(--set cluster.advertise_host=127.0.0.1 --set cluster.heartbeat_ms=200 --set cluster.peer_timeout_ms=1500
-  --set cluster.publish_every_updates=50 --set train.max_updates=100000000 --set train.eval_every_updates=0
-  --set train.checkpoint_every_seconds=1 --set train.log_every_seconds=0.5 --set replay.warmup=200
-  --set replay.shards=2 --metrics-bind 127.0.0.1 --metrics-port 0)
-start_learner() {  # $1: log name; the rest: --config/--run-dir or --resume and binds
-  local log=$work/logs/$1.log
-  shift
-  "$bin" learner "$@" "${common[@]}" >"$log" 2>&1 &
-  pid[learner]=$!
-  join=""
-  wait_for 30 "the learner did not report its join endpoint" \
-    'join=$(grep -o "join: *tcp://127.0.0.1:[0-9]*" "$log" | head -n1 | grep -o "tcp://.*" || true); [[ -n $join ]]'
-  weights=$(grep -o "weights: *tcp://127.0.0.1:[0-9]*" "$log" | head -n1 | grep -o 'tcp://.*')
-  wait_for 30 "the learner did not list its metrics URL" '[[ -s $work/run/metrics_urls.txt ]]'
-  lurl=$(head -n 1 "$work/run/metrics_urls.txt")
-}
-start_shard() {  # $1: index
-  "$bin" replay --join "$join" --insert-bind tcp://127.0.0.1:0 --sample-bind tcp://127.0.0.1:0 \
-    --snapshot "$work/shard-$1.replay" --snapshot-every 1 >"$work/logs/shard-$1.log" 2>&1 &
-  pid[shard$1]=$!
-  local log=$work/logs/shard-$1.log  # (wait_for's conditions cannot see $1)
-  wait_for 30 "shard $1 did not log its metrics URL" '[[ -n $(url_in "$log") ]]'
-  surl[$1]=$(url_in "$log")
-}
-start_actor() {  # $1: index, $2: log name
-  "$bin" actor --join "$join" --seed $((30 + $1)) >"$work/logs/$2.log" 2>&1 &
-  pid[actor$1]=$!
-  local log=$work/logs/$2.log
-  wait_for 30 "actor $1 did not log its metrics URL" '[[ -n $(url_in "$log") ]]'
-  aurl[$1]=$(url_in "$log")
-}
-declare -A surl=() aurl=()
-updates() { metric "$lurl" pamdp_updates_total; }
-peers() { metric "$lurl" pamdp_learner_peers_connected "role=\"$1\""; }
-# Waits until the learner's updates exceed their value now by N.
-updates_grow() {
-  local from
-  from=$(updates)
-  from=${from:-0}
-  wait_for 30 "$1: learner updates stuck at $(updates) (from $from)" "gt \"\$(updates)\" $((${from%.*} + $2))"
-}
 
 start_learner learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
   --set cluster.learner_bind=tcp://127.0.0.1:0 --set cluster.weights_bind=tcp://127.0.0.1:0
-start_shard 0
-start_shard 1
+start_shard 0 --snapshot "$work/shard-0.replay" --snapshot-every 1
+start_shard 1 --snapshot "$work/shard-1.replay" --snapshot-every 1
 start_actor 0 actor-0
 start_actor 1 actor-1
 wait_for 30 "the cluster did not form (shards $(peers replay), actors $(peers actor))" \
@@ -132,7 +54,7 @@ faults=$((faults + 1))
 snapshot_bytes=$(stat -c %s "$work/shard-1.replay")
 wait_for 20 "the learner still counts 2 shards after kill -9" '[[ $(peers replay) == 1 ]]'
 updates_grow "shard killed" 100
-start_shard 1
+start_shard 1 --snapshot "$work/shard-1.replay" --snapshot-every 1
 wait_for 20 "the restarted shard did not take its config" 'gt "$(metric "${surl[1]}" pamdp_replay_capacity_transitions)" 0'
 # Both from one scrape: actors insert into the new shard as soon as they hear of it.
 scrape=$(curl -sf --max-time 2 "${surl[1]}" || true)
