@@ -229,5 +229,100 @@ TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   EXPECT_EQ(server.counters().actors_alive, 1);
 }
 
+// With CURVE, a peer whose key the cluster did not issue (even one that knows the learner's
+// public key) is refused in the handshake at both of the learner's bound sockets: its JoinRequest
+// is never answered and its SUB never receives weights, while a subscriber with the cluster's key
+// gets every publication of the same run.
+TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
+  const net::CurveServerKeys server_keys = net::generate_curve_keypair();
+  const net::CurveServerKeys cluster_client = net::generate_curve_keypair();
+  const net::CurveServerKeys intruder = net::generate_curve_keypair();
+  const net::CurveClientKeys good{cluster_client.public_key, cluster_client.secret_key, server_keys.public_key};
+  const net::CurveClientKeys bad{intruder.public_key, intruder.secret_key, server_keys.public_key};
+
+  net::Context ctx;
+  net::CurveAuthenticator auth(ctx, {cluster_client.public_key});  // before the sockets
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
+  LearnerServerConfig c;
+  c.join_bind = "tcp://127.0.0.1:*";
+  c.weights_bind = "tcp://127.0.0.1:*";
+  c.config_toml = "[env]\nname = \"reach_stop\"\n";
+  c.publish_every_updates = 2;
+  c.max_updates = 400;
+  c.peer_timeout_ms = 60000;
+  c.curve = server_keys;
+  c.curve_client = good;
+  LearnerServer server(ctx, backend, c);
+  std::atomic<bool> done{false};
+  std::thread thread([&] {
+    server.run();
+    done.store(true);
+  });
+
+  // Subscribers and an intruding joiner first (CURVE applies to connections made after the keys).
+  net::Socket good_sub(ctx, net::SocketType::kSub);
+  good_sub.make_curve_client(good);
+  good_sub.subscribe_all();
+  good_sub.connect(server.weights_endpoint());
+  net::Socket bad_sub(ctx, net::SocketType::kSub);
+  bad_sub.make_curve_client(bad);
+  bad_sub.subscribe_all();
+  bad_sub.connect(server.weights_endpoint());
+  flatbuffers::FlatBufferBuilder fbb;
+  net::Socket bad_join(ctx, net::SocketType::kDealer);
+  bad_join.make_curve_client(bad);
+  bad_join.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Actor, "intruder", "", "", 1);
+  (void)bad_join.send(wire::bytes_of(fbb), 200);  // queued until a handshake that never succeeds
+
+  // A shard with the cluster's key: its sample socket is a CURVE server with the cluster's keys.
+  net::Socket sample(ctx, net::SocketType::kRouter);
+  sample.make_curve_server(server_keys);
+  const std::string sample_endpoint = sample.bind("tcp://127.0.0.1:*");
+  net::Socket join(ctx, net::SocketType::kDealer);
+  join.make_curve_client(good);
+  join.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
+  ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
+  net::Message m;
+  ASSERT_NE(await_payload(join, m, wire::Payload::ClusterMap), nullptr);
+
+  // Serve samples until the run ends; the good subscriber counts what it receives meanwhile.
+  std::vector<float> states(kBatch * kObs, 0.1F);
+  std::vector<float> actions(kBatch * kAct, 0.2F);
+  std::vector<float> rewards(kBatch, 1.0F);
+  std::vector<uint8_t> terminals(kBatch, 0);
+  const wire::TransitionRows rows{kBatch,         kObs,           kAct,          states.data(),
+                                  actions.data(), rewards.data(), states.data(), terminals.data(),
+                                  rewards.data()};
+  int received = 0;
+  net::Message id;
+  net::Message req;
+  const auto until = Clock::now() + std::chrono::seconds(20);
+  while (!done.load() && Clock::now() < until) {
+    while (good_sub.recv(m, 0)) {
+      const wire::Envelope* e = wire::open_envelope(m.bytes());
+      received += e != nullptr && e->payload_as_PolicyWeights() != nullptr ? 1 : 0;
+    }
+    if (!sample.recv_from(id, req, 20)) {
+      continue;
+    }
+    const wire::Envelope* e = wire::open_envelope(req.bytes());
+    ASSERT_NE(e, nullptr);
+    wire::build_sample_reply(fbb, e->payload_as_SampleRequest()->request_id(), rows);
+    ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
+  }
+  ASSERT_TRUE(done.load()) << "the learner did not reach max_updates";
+  thread.join();
+  EXPECT_GT(received, 10) << "the subscriber with the cluster's key got " << received << " publications";
+  EXPECT_FALSE(bad_sub.recv(m, 300)) << "a subscriber with a foreign key received weights";
+  EXPECT_FALSE(bad_join.recv(m, 300)) << "a joiner with a foreign key was answered";
+  EXPECT_GE(auth.refused(), 2);
+  EXPECT_EQ(server.counters().actors_alive, 0);
+  EXPECT_EQ(server.counters().malformed_messages, 0);
+}
+
 }  // namespace
 }  // namespace pamdp
