@@ -1,0 +1,270 @@
+// HfoServerEnv over HFO's client library. Compiled only with -DHFO_ROOT (PAMDP_HFO_ROOT is that
+// path); hfo_server_unavailable.cpp stands in for it otherwise.
+#include "envs/hfo_server/hfo_server_env.hpp"
+
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+#include <HFO.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+#include "envs/hfo/features.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/soccer_sim.hpp"
+#include "envs/hfo_server/feature_encoding.hpp"
+
+namespace pamdp::hfo_server {
+namespace {
+
+// HFO's status codes are the embedded env's (reference §4); the adapter passes them through.
+static_assert(static_cast<int>(::hfo::IN_GAME) == hfo::kInGame);
+static_assert(static_cast<int>(::hfo::GOAL) == hfo::kGoal);
+static_assert(static_cast<int>(::hfo::CAPTURED_BY_DEFENSE) == hfo::kCapturedByDefense);
+static_assert(static_cast<int>(::hfo::OUT_OF_BOUNDS) == hfo::kOutOfBounds);
+static_assert(static_cast<int>(::hfo::OUT_OF_TIME) == hfo::kOutOfTime);
+
+[[noreturn]] void misuse(const char* what) {
+  std::fprintf(stderr, "HfoServerEnv: %s\n", what);
+  std::abort();
+}
+
+std::string address(const HfoServerConfig& c) {
+  return c.host + ":" + std::to_string(c.port);
+}
+
+std::string how_to_start(const HfoServerConfig& c) {
+  return "start one first, e.g. " PAMDP_HFO_ROOT "/bin/HFO --offense-agents 1" +
+         std::string(c.opponents > 0 ? " --defense-npcs " + std::to_string(c.opponents) : "") +
+         " --fullstate --headless --no-logging --frames-per-trial " + std::to_string(c.max_steps) + " --port " +
+         std::to_string(c.port) +
+         " --seed S, and wait for its line 'Waiting for player-controlled agent' "
+         "(one server per env, ports at least 3 apart; docs/hfo-server.md)";
+}
+
+// HFO's client library calls exit(1) when it cannot start (it has no error return). While a
+// connection is being made, this says which server and what to do before the process ends.
+char g_connecting_to[512] = {};
+extern "C" void explain_exit_while_connecting() {
+  if (g_connecting_to[0] != '\0') {
+    std::fprintf(stderr,
+                 "hfo-server: HFO's client library gave up connecting to %s (its message above). Connect only "
+                 "after bin/HFO has printed 'Waiting for player-controlled agent' (an agent that joins earlier takes "
+                 "an NPC's place and the game never starts), and to a server whose agent slot is free.\n",
+                 g_connecting_to);
+  }
+}
+
+// rcssserver answers any unknown datagram on its player port with "(error unknown_command)", so
+// one probe tells whether a server listens there without joining its game. Retried every 0.5 s
+// for `wait_s` seconds (a server that is still starting up answers late).
+void probe_server(const HfoServerConfig& c) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_DGRAM;
+  addrinfo* found = nullptr;
+  const std::string port = std::to_string(c.port);
+  if (const int rc = getaddrinfo(c.host.c_str(), port.c_str(), &hints, &found); rc != 0) {
+    throw std::runtime_error("hfo-server: cannot resolve env.server_host '" + c.host + "': " + gai_strerror(rc));
+  }
+  const int fd = socket(found->ai_family, found->ai_socktype, found->ai_protocol);
+  const bool connected = fd >= 0 && ::connect(fd, found->ai_addr, found->ai_addrlen) == 0;
+  freeaddrinfo(found);
+  if (!connected) {
+    if (fd >= 0) {
+      close(fd);
+    }
+    throw std::runtime_error("hfo-server: cannot open a UDP socket to " + address(c));
+  }
+  static constexpr char kProbe[] = "(pamdp_probe)";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(c.connect_wait_s);
+  bool answered = false;
+  while (!answered && std::chrono::steady_clock::now() < deadline) {
+    (void)send(fd, kProbe, sizeof(kProbe), 0);
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, 500) > 0) {
+      std::array<char, 256> reply{};
+      answered = recv(fd, reply.data(), reply.size(), 0) > 0;  // refused (ICMP) reads as -1
+      if (!answered) {
+        usleep(500 * 1000);
+      }
+    }
+  }
+  close(fd);
+  if (!answered) {
+    throw std::runtime_error("hfo-server: no HFO server answers at " + address(c) + " (waited " +
+                             std::to_string(c.connect_wait_s) + " s); " + how_to_start(c));
+  }
+}
+
+class HfoServerEnv final : public Env {
+ public:
+  explicit HfoServerEnv(HfoServerConfig config)
+      : c_(std::move(config)),
+        native_size_(e3_feature_count(0, c_.opponents)),
+        embedded_(static_cast<size_t>(hfo::feature_count(1 + c_.opponents))) {}
+
+  ~HfoServerEnv() override {
+    if (client_ != nullptr) {
+      // Leave the game cleanly ("(bye)"); HFO's trainer then ends the server's session.
+      client_->act(::hfo::QUIT);
+      (void)client_->step();
+    }
+  }
+
+  [[nodiscard]] std::string_view name() const override { return "hfo-server"; }
+  [[nodiscard]] const ActionSpace& action_space() const override { return hfo::hfo_action_space(); }
+  [[nodiscard]] int observation_size() const override { return hfo_server::observation_size(c_); }
+  [[nodiscard]] int max_episode_steps() const override { return c_.max_steps + 1; }
+  [[nodiscard]] std::string_view status_name(int status) const override { return hfo::status_name(status); }
+  [[nodiscard]] std::span<const int> outcomes() const override {
+    static constexpr std::array<int, 5> kOutcomes{hfo::kInGame, hfo::kGoal, hfo::kCapturedByDefense, hfo::kOutOfBounds,
+                                                  hfo::kOutOfTime};
+    return kOutcomes;
+  }
+  [[nodiscard]] int success_status() const override { return hfo::kGoal; }
+
+  // The server's --seed governs its episodes; a seed cannot be sent to it.
+  void reset(uint64_t /*seed*/, std::span<float> obs) override { reset(obs); }
+
+  void reset(std::span<float> obs) override {
+    if (client_ == nullptr) {
+      connect();
+    } else if (!at_episode_start_) {
+      finish_server_episode();
+    }
+    at_episode_start_ = true;
+    episode_over_ = false;
+    steps_ = 0;
+    reward_.reset();
+    write_observation(obs);
+  }
+
+  StepResult step(const ParamAction& action, std::span<float> obs) override {
+    if (client_ == nullptr || episode_over_) {
+      misuse("step() before reset() or after a terminal status; call reset() first");
+    }
+    if (action.params.size() < static_cast<size_t>(hfo::param::kCount)) {
+      misuse("step(): the parameter vector must hold the 6 HFO parameters");
+    }
+    const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
+    switch (action.id) {
+      case hfo::kDash: client_->act(::hfo::DASH, p(hfo::param::kDashPower), p(hfo::param::kDashDir)); break;
+      case hfo::kTurn: client_->act(::hfo::TURN, p(hfo::param::kTurnDir)); break;
+      case hfo::kTackle: client_->act(::hfo::TACKLE, p(hfo::param::kTackleDir)); break;
+      case hfo::kKick: client_->act(::hfo::KICK, p(hfo::param::kKickPower), p(hfo::param::kKickDir)); break;
+      default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
+    }
+    int status = server_step();
+    ++steps_;
+    // A terminal status arrives with the next episode's first state (HFO's client already played
+    // its three NOOPs), which reset() then returns.
+    at_episode_start_ = status != hfo::kInGame;
+    if (status == hfo::kInGame && steps_ >= max_episode_steps()) {
+      status = hfo::kOutOfTime;  // the server's trial goes on; reset() plays it out
+    }
+    episode_over_ = status != hfo::kInGame;
+    write_observation(obs);
+    return {reward_(embedded_, status), status};
+  }
+
+ private:
+  void connect() {
+    const std::string config_dir =
+        c_.config_dir.empty() ? std::string(PAMDP_HFO_ROOT "/bin/teams/base/config/formations-dt") : c_.config_dir;
+    if (!std::filesystem::is_directory(config_dir)) {
+      throw std::runtime_error("hfo-server: env.server_config_dir '" + config_dir +
+                               "' is not a directory; point it at HFO's bin/teams/base/config/formations-dt");
+    }
+    probe_server(c_);
+    static const bool registered = std::atexit(explain_exit_while_connecting) == 0;
+    (void)registered;
+    std::snprintf(g_connecting_to, sizeof(g_connecting_to), "%s", address(c_).c_str());
+    client_ = std::make_unique<::hfo::HFOEnvironment>();
+    client_->connectToServer(::hfo::LOW_LEVEL_FEATURE_SET, config_dir, c_.port, c_.host, c_.team,
+                             /*play_goalie=*/false);
+    g_connecting_to[0] = '\0';
+    const int teammates = client_->getNumTeammates();
+    const int opponents = client_->getNumOpponents();
+    const auto features = static_cast<int>(client_->getState().size());
+    if (teammates != 0 || opponents != c_.opponents || features != native_size_) {
+      throw std::runtime_error("hfo-server: the server at " + address(c_) + " runs " + std::to_string(teammates) +
+                               " teammate(s) and " + std::to_string(opponents) + " opponent(s) (" +
+                               std::to_string(features) + " features); this env expects 0 and " +
+                               std::to_string(c_.opponents) +
+                               " (env.goalie = true for a server started with --defense-npcs 1)");
+    }
+    // The state at connection is the one before kick-off; the server places ball and players for
+    // the first episode in the first cycle of play. Two NOOPs make the first observation, like
+    // every later episode's (HFO's client NOOPs after a terminal status), two cycles into it.
+    for (int i = 0; i < 2; ++i) {
+      client_->act(::hfo::NOOP);
+      (void)server_step();
+    }
+  }
+
+  int server_step() {
+    const ::hfo::status_t s = client_->step();
+    if (s == ::hfo::SERVER_DOWN) {
+      throw std::runtime_error("hfo-server: the HFO server at " + address(c_) +
+                               " went down (SERVER_DOWN): it stops when its game ends or its process dies; " +
+                               how_to_start(c_));
+    }
+    return static_cast<int>(s);
+  }
+
+  // Plays NOOPs until the server ends its current episode.
+  void finish_server_episode() {
+    for (int n = 0; n < 100 * (c_.max_steps + 200); ++n) {
+      client_->act(::hfo::NOOP);
+      if (server_step() != hfo::kInGame) {
+        return;
+      }
+    }
+    throw std::runtime_error("hfo-server: the server at " + address(c_) +
+                             " did not end its episode while the agent waited; is its --untouched-time set?");
+  }
+
+  void write_observation(std::span<float> obs) {
+    const std::vector<float>& state = client_->getState();
+    if (static_cast<int>(state.size()) != native_size_) {
+      throw std::runtime_error("hfo-server: the server sent " + std::to_string(state.size()) + " features, expected " +
+                               std::to_string(native_size_));
+    }
+    e3_to_embedded(state, 0, c_.opponents, embedded_);
+    if (c_.encoding == Encoding::kNative) {
+      std::copy(state.begin(), state.end(), obs.begin());
+    } else {
+      std::copy(embedded_.begin(), embedded_.end(), obs.begin());
+    }
+  }
+
+  HfoServerConfig c_;
+  int native_size_;
+  std::unique_ptr<::hfo::HFOEnvironment> client_;
+  std::vector<float> embedded_;  // the 58-feature view: the reward's input in both encodings
+  hfo::ShapedReward reward_;
+  int steps_ = 0;
+  bool at_episode_start_ = false;
+  bool episode_over_ = false;
+};
+
+}  // namespace
+
+bool built_with_hfo() {
+  return true;
+}
+
+std::unique_ptr<Env> make_hfo_server_env(const HfoServerConfig& config) {
+  return std::make_unique<HfoServerEnv>(config);
+}
+
+}  // namespace pamdp::hfo_server

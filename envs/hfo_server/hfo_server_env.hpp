@@ -1,0 +1,67 @@
+// The real HFO server (LARG/HFO with its rcssserver fork) behind the Env interface, through
+// HFO's own C++ client library (HFO.hpp, libhfo). Built only when CMake is given
+// -DHFO_ROOT=/path/to/HFO; without it make_hfo_server_env() throws the one-line fix.
+//
+// Contract beyond envs/env.hpp:
+//  - One env is one player of one running server (`bin/HFO --offense-agents 1 --fullstate
+//    --headless --port P`); the server must be started before the env's first reset() and
+//    ends when the env disconnects (HFO's trainer stops the game when its agent leaves).
+//  - Connects lazily, on the first reset(): constructing one (to learn the observation size, as
+//    the learner and replay shards do) opens no socket. Connecting allocates; steps then do not,
+//    apart from what HFO's client library does inside.
+//  - The server's random seed (bin/HFO --seed) governs start positions and noise; reset(seed)
+//    cannot reseed it and behaves as reset().
+//  - Episode boundaries are the server's: after a terminal status, HFO's client plays three
+//    NOOPs, so the observation returned with a terminal status already shows the next episode's
+//    start, and reset() returns that state without stepping. reset() in the middle of an
+//    episode sends NOOPs until the server ends it (the untouched-ball rule does, within about
+//    100 cycles). The env also ends an episode itself (OUT_OF_TIME) at `max_steps` agent steps,
+//    in case the server allows longer trials.
+//  - The reward is the embedded env's (reference §6.2, hfo::ShapedReward), always computed from
+//    the 58-feature encoding, whichever encoding the agent sees.
+//  - A server that goes down (SERVER_DOWN) or never answers is a std::runtime_error naming
+//    host:port and how to start one.
+//  - Not thread-safe; one env per thread (HFO's client keeps process-wide parameter singletons,
+//    so one env per process is the tested case).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "envs/env.hpp"
+#include "envs/hfo/features.hpp"
+#include "envs/hfo_server/feature_encoding.hpp"
+
+namespace pamdp::hfo_server {
+
+enum class Encoding {
+  kNative,    // the server's own features: 59 in 1v0, + 9 per opponent (reference §3.4)
+  kEmbedded,  // converted to the embedded simulator's: 58, + 8 per opponent (§3.2), exact
+};
+
+struct HfoServerConfig {
+  std::string host = "localhost";
+  int port = 6000;  // bin/HFO --port
+  Encoding encoding = Encoding::kNative;
+  std::string team = "base_left";  // HFO's offense team name
+  // agent2d formation files; empty: the HFO_ROOT given to CMake + bin/teams/base/config/formations-dt.
+  std::string config_dir;
+  int opponents = 0;        // defense players on the server: 1 with bin/HFO --defense-npcs 1 (a goalie)
+  int max_steps = 500;      // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
+  int connect_wait_s = 10;  // how long the first reset() waits for a server to answer
+};
+
+// Observation width for `config` (native: 59 + 9 * opponents; embedded: 58 + 8 * opponents).
+inline int observation_size(const HfoServerConfig& config) {
+  return config.encoding == Encoding::kNative ? e3_feature_count(0, config.opponents)
+                                              : hfo::feature_count(1 + config.opponents);
+}
+
+// True when this build links HFO's client library.
+bool built_with_hfo();
+
+// A new env for `config`. Throws std::runtime_error("... rebuild with -DHFO_ROOT=...") when the
+// build has no HFO. Does not connect (see above).
+std::unique_ptr<Env> make_hfo_server_env(const HfoServerConfig& config);
+
+}  // namespace pamdp::hfo_server
