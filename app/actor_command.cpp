@@ -41,6 +41,8 @@ struct ActorCliOptions {
   double progress_every_s = 5.0;
   std::string metrics_bind = "127.0.0.1";
   int metrics_port = 0;
+  std::string server_host;  // overrides env.server_host (env.name = "hfo-server")
+  int server_port = 0;      // overrides env.server_port; 0 = the cluster's
 };
 
 std::string default_name() {
@@ -81,7 +83,19 @@ void run_actor(const ActorCliOptions& o) {
                              " ms; start `pamdp learner` first or check the address (--join tcp://HOST:PORT), or wait "
                              "longer with --join-timeout");
   }
-  const ExperimentConfig config = parse_experiment_config(map->config_toml, "the cluster map from " + o.join, {});
+  ExperimentConfig config = parse_experiment_config(map->config_toml, "the cluster map from " + o.join, {});
+  // Every actor has an HFO server of its own; the cluster's config names one port for all.
+  if (!o.server_host.empty()) {
+    config.env.server_host = o.server_host;
+  }
+  if (o.server_port > 0) {
+    config.env.server_port = o.server_port;
+  }
+  if (config.env.name == "hfo-server" && o.envs > 1) {
+    throw std::runtime_error("--envs " + std::to_string(o.envs) +
+                             ": env 'hfo-server' plays one HFO server per actor; start one actor per server, each "
+                             "with --envs 1 --server-port PORT");
+  }
 
   std::vector<std::unique_ptr<Env>> envs;
   envs.reserve(static_cast<size_t>(o.envs));
@@ -125,8 +139,11 @@ void run_actor(const ActorCliOptions& o) {
     last = now;
     last_steps = steps;
   };
-  std::printf("pamdp actor: actor %u, %d %s env(s), %zu shard(s), learner %s\n", loop.actor_index(), o.envs,
-              config.env.name.c_str(), map->shard_endpoints.size(), o.join.c_str());
+  const std::string server = config.env.name == "hfo-server"
+                                 ? " at " + config.env.server_host + ":" + std::to_string(config.env.server_port)
+                                 : std::string();
+  std::printf("pamdp actor: actor %u, %d %s env(s)%s, %zu shard(s), learner %s\n", loop.actor_index(), o.envs,
+              config.env.name.c_str(), server.c_str(), map->shard_endpoints.size(), o.join.c_str());
   std::fflush(stdout);
   loop.run(g_stop);
   std::printf("done: %lld env steps, %lld episodes, %lld batches (%lld transitions) sent, weights v%lld\n",
@@ -166,6 +183,11 @@ void register_actor(CLI::App& app) {
   cmd->add_option("--metrics-port", o->metrics_port, "port of /metrics (0: any free port, logged)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
+  cmd->add_option("--server-host", o->server_host,
+                  "env 'hfo-server': host of this actor's HFO server (default: the cluster's env.server_host)");
+  cmd->add_option("--server-port", o->server_port,
+                  "env 'hfo-server': port of this actor's HFO server (default: the cluster's env.server_port)")
+      ->check(CLI::Range(1, 65535));
   cmd->add_option("--log-level", "trace, debug, info, warn, error or off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
       ->each([](const std::string& level) { log::set_level(level); });

@@ -1,7 +1,9 @@
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "app/actor_policy.hpp"
 #include "app/commands.hpp"
@@ -24,6 +26,8 @@ struct EvalOptions {
   uint64_t seed = 1;
   bool json = false;
   std::string checkpoint;
+  std::string env;                // overrides env.name
+  std::vector<std::string> sets;  // env.* overrides
   SimOptions sim;
 };
 
@@ -42,17 +46,64 @@ void print_result(const std::string& name, const EvalResult& r, bool json) {
   }
 }
 
-// A progress bar on stderr while it plays (only on a terminal).
-EvalResult evaluate_with_progress(Env& env, Policy& policy, const EvalOptions& o) {
+// Plays the episodes with a progress bar on stderr (only on a terminal), then gives the env back
+// (a real server's client prints as it leaves, which must come before the table) and reports
+// the pace on stderr (stdout stays the same for the same seed).
+EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, const EvalOptions& o) {
   ProgressBar bar("episodes", o.episodes);
-  EvalResult r = evaluate(env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); });
+  const auto start = std::chrono::steady_clock::now();
+  EvalResult r = evaluate(*env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   bar.finish();
+  const std::string env_name(env->name());
+  env.reset();
+  const double steps = r.avg_steps * r.episodes;
+  std::fprintf(stderr, "eval: env %s, %.0f steps in %.1f s (%.0f steps/s)\n", env_name.c_str(), steps, seconds,
+               seconds > 0.0 ? steps / seconds : 0.0);
   return r;
 }
 
-// A trained actor, with the env and bounds of the run that wrote the checkpoint.
-void run_checkpoint_eval(const EvalOptions& o) {
+// Settings of the embedded simulator that the real server takes as its own flags instead.
+void refuse_sim_options_on_server(const CLI::App& cmd) {
+  for (const char* flag : {"--no-noise", "--start", "--referee", "--body-reset", "--untouched-limit"}) {
+    if (cmd.count(flag) > 0) {
+      throw std::runtime_error(std::string(flag) +
+                               " sets up the embedded simulator; the HFO server takes its own flags (bin/HFO "
+                               "--deterministic, --ball-x-min/--ball-x-max, --untouched-time; docs/hfo-server.md)");
+    }
+  }
+}
+
+// `sets` applied to `c` with the config file's validation; only env.* keys.
+ExperimentConfig with_env_overrides(const ExperimentConfig& c, const std::vector<std::string>& sets) {
+  for (const std::string& s : sets) {
+    if (s.rfind("env.", 0) != 0) {
+      throw std::runtime_error("--set '" + s + "': eval takes env.* settings only, e.g. --set env.server_port=7000");
+    }
+  }
+  return sets.empty() ? c : parse_experiment_config(to_toml(c), "eval --set", sets);
+}
+
+// A trained actor, with the env and bounds of the run that wrote the checkpoint; `--env
+// hfo-server` plays it on the real server, in the embedded encoding when it was trained in-process.
+void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   ExperimentConfig c = parse_experiment_config(read_checkpoint_config(o.checkpoint), o.checkpoint + " (config)", {});
+  const int trained_width = observation_size(c.env);
+  const std::string trained_env = c.env.name;
+  if (!o.env.empty() && o.env != c.env.name) {
+    c.env.name = o.env;
+    if (o.env == "hfo-server" && trained_env == "hfo") {
+      c.env.server_encoding = hfo_server::Encoding::kEmbedded;
+      std::fprintf(stderr,
+                   "eval: %s was trained on the embedded simulator; the server's features are given to it in the "
+                   "embedded encoding (env.server_encoding = embedded)\n",
+                   o.checkpoint.c_str());
+    }
+  }
+  c = with_env_overrides(c, o.sets);
+  if (c.env.name == "hfo-server") {
+    refuse_sim_options_on_server(cmd);
+  }
   if (o.sim.no_noise) {
     c.env.hfo.noise = false;
   }
@@ -62,29 +113,53 @@ void run_checkpoint_eval(const EvalOptions& o) {
                              "evaluated on its own env");
   }
   auto env = make_env(c.env);
+  if (env->observation_size() != trained_width) {
+    throw std::runtime_error(
+        "--env " + c.env.name + ": " + o.checkpoint + " reads " + std::to_string(trained_width) +
+        " features (trained on env '" + trained_env + "'), env '" + c.env.name + "' gives " +
+        std::to_string(env->observation_size()) +
+        (c.env.name == "hfo-server" ? " (env.server_encoding = embedded gives the embedded width)" : std::string()));
+  }
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
-  print_result("ddpg", evaluate_with_progress(*env, policy, o), o.json);
+  print_result("ddpg", evaluate_with_progress(std::move(env), policy, o), o.json);
 }
 
-void run_eval(const EvalOptions& o) {
+void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (!o.checkpoint.empty()) {
-    run_checkpoint_eval(o);
+    run_checkpoint_eval(o, cmd);
     return;
   }
-  hfo::HfoEnv env(o.sim.resolved());
+  ExperimentConfig c;
+  c.env.name = o.env.empty() ? "hfo" : o.env;
+  c.env.hfo = o.sim.resolved();
+  if (c.env.name == "hfo-server") {
+    refuse_sim_options_on_server(cmd);
+    if (o.policy == "scripted") {
+      c.env.server_encoding = hfo_server::Encoding::kEmbedded;  // it reads the embedded features
+    }
+  }
+  c = with_env_overrides(c, o.sets);
+  if (c.env.name != "hfo" && c.env.name != "hfo-server") {
+    throw std::runtime_error("--policy " + o.policy + " plays HFO; env '" + c.env.name + "' takes --checkpoint");
+  }
+  if (o.policy == "scripted" && c.env.name == "hfo-server" &&
+      c.env.server_encoding != hfo_server::Encoding::kEmbedded) {
+    throw std::runtime_error("--policy scripted reads the embedded encoding: leave env.server_encoding = embedded");
+  }
+  auto env = make_env(c.env);
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {
     policy = std::make_unique<hfo::ScriptedOffense>();
   } else {
     // The paper's exploration draw: Tackle masked, dash power U[-100, 100] (reference §7.3).
-    auto random = std::make_unique<RandomPolicy>(env.action_space(), o.seed ^ 0x5eedULL,
+    auto random = std::make_unique<RandomPolicy>(env->action_space(), o.seed ^ 0x5eedULL,
                                                  std::vector<int>{hfo::kDash, hfo::kTurn, hfo::kKick});
     random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
     policy = std::move(random);
   }
-  print_result(o.policy, evaluate_with_progress(env, *policy, o), o.json);
+  print_result(o.policy, evaluate_with_progress(std::move(env), *policy, o), o.json);
 }
 
 }  // namespace
@@ -103,8 +178,15 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--checkpoint", opts->checkpoint,
                   "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--env", opts->env,
+                  "play on this env instead (hfo, hfo-server: a running HFO server, docs/hfo-server.md; "
+                  "reach_stop with --checkpoint); a checkpoint trained on hfo gets the server's features in "
+                  "the embedded encoding")
+      ->check(CLI::IsMember({"hfo", "hfo-server", "reach_stop"}));
+  cmd->add_option("--set", opts->sets,
+                  "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
   opts->sim.add_to(*cmd);
-  cmd->callback([opts] { run_eval(*opts); });
+  cmd->callback([opts, cmd] { run_eval(*opts, *cmd); });
 }
 
 }  // namespace pamdp::app

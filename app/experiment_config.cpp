@@ -13,7 +13,6 @@ namespace {
 
 const Choices<BoundMethod> kBounds{
     {"inverting", BoundMethod::kInverting}, {"zeroing", BoundMethod::kZeroing}, {"squashing", BoundMethod::kSquashing}};
-const Choices<std::string> kEnvs{{"hfo", "hfo"}, {"reach_stop", "reach_stop"}};
 const Choices<UpdateDevice> kDevices{
     {"auto", UpdateDevice::kAuto}, {"cpu", UpdateDevice::kCpu}, {"cuda", UpdateDevice::kCuda}};
 
@@ -33,7 +32,7 @@ std::vector<std::string> split_path(const std::string& key) {
 template <typename V>
 void visit(V& v, ExperimentConfig& c) {
   v.integer("seed", c.seed, 0, INT64_MAX);
-  v.choice("env.name", c.env.name, kEnvs);
+  v.choice("env.name", c.env.name, env_choices());
   v.boolean("env.noise", c.env.hfo.noise);
   v.choice("env.start", c.env.hfo.start, start_choices());
   v.choice("env.referee", c.env.hfo.referee, referee_choices());
@@ -41,6 +40,12 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("env.max_steps", c.env.hfo.max_steps, 1, 1000000);
   v.integer("env.untouched_limit", c.env.hfo.untouched_limit, 1, 1000000);
   v.boolean("env.goalie", c.env.hfo.goalie);
+  v.text("env.server_host", c.env.server_host);
+  v.integer("env.server_port", c.env.server_port, 1, 65535);
+  v.integer("env.server_eval_port", c.env.server_eval_port, 0, 65535);
+  v.choice("env.server_encoding", c.env.server_encoding, server_encoding_choices());
+  v.text("env.server_team", c.env.server_team);
+  v.text_or_empty("env.server_config_dir", c.env.server_config_dir);
 
   v.int_list("ddpg.hidden", c.ddpg.hidden, 1, 1 << 16);
   v.real("ddpg.actor_learning_rate", c.ddpg.actor_learning_rate, 0.0, 1.0);
@@ -131,6 +136,15 @@ class Reader {
       const auto v = n->value_exact<std::string>();
       if (!v || v->empty()) {
         fail(key, "must be a non-empty string");
+      }
+      out = *v;
+    }
+  }
+  void text_or_empty(const std::string& key, std::string& out) {
+    if (const toml::node* n = find(key)) {
+      const auto v = n->value_exact<std::string>();
+      if (!v) {
+        fail(key, "must be a string");
       }
       out = *v;
     }
@@ -295,6 +309,7 @@ class Writer {
   void real(const std::string& key, const double& v, double /*lo*/, double /*hi*/) { put(key, v); }
   void boolean(const std::string& key, const bool& v) { put(key, v); }
   void text(const std::string& key, const std::string& v) { put(key, v); }
+  void text_or_empty(const std::string& key, const std::string& v) { put(key, v); }
   template <typename E>
   void choice(const std::string& key, const E& v, const Choices<E>& choices) {
     for (const auto& [name, value] : choices) {
@@ -399,6 +414,18 @@ const Choices<hfo::StartDistribution>& start_choices() {
 
 const Choices<hfo::Referee>& referee_choices() {
   static const Choices<hfo::Referee> kChoices{{"server", hfo::Referee::kServer}, {"trainer", hfo::Referee::kTrainer}};
+  return kChoices;
+}
+
+const Choices<std::string>& env_choices() {
+  static const Choices<std::string> kChoices{
+      {"hfo", "hfo"}, {"reach_stop", "reach_stop"}, {"hfo-server", "hfo-server"}};
+  return kChoices;
+}
+
+const Choices<hfo_server::Encoding>& server_encoding_choices() {
+  static const Choices<hfo_server::Encoding> kChoices{{"native", hfo_server::Encoding::kNative},
+                                                      {"embedded", hfo_server::Encoding::kEmbedded}};
   return kChoices;
 }
 

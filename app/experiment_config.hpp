@@ -11,13 +11,25 @@
 
 #include "actor/exploration.hpp"
 #include "envs/hfo/soccer_sim.hpp"
+#include "envs/hfo_server/hfo_server_env.hpp"
 #include "learner/ddpg.hpp"
 
 namespace pamdp::app {
 
 struct EnvConfig {
-  std::string name = "hfo";  // "hfo" or "reach_stop"
+  std::string name = "hfo";  // "hfo", "reach_stop" or "hfo-server"
   hfo::SoccerSimConfig hfo;
+  // The real HFO server (env.name = "hfo-server", docs/hfo-server.md). Of the keys above, goalie
+  // says the server runs one (bin/HFO --defense-npcs 1) and max_steps is its --frames-per-trial;
+  // the others belong to the embedded simulator (the server's own flags set them).
+  std::string server_host = "localhost";
+  int server_port = 6000;  // bin/HFO --port
+  // The server of the greedy evaluations that `pamdp train` and `pamdp learner` run
+  // (train.eval_every_updates > 0); 0 = none.
+  int server_eval_port = 0;
+  hfo_server::Encoding server_encoding = hfo_server::Encoding::kNative;
+  std::string server_team = "base_left";
+  std::string server_config_dir;  // empty: HFO_ROOT/bin/teams/base/config/formations-dt
 };
 
 struct ReplayConfig {
@@ -85,6 +97,8 @@ using Choices = std::vector<std::pair<std::string, E>>;
 const Choices<hfo::StartDistribution>& start_choices();
 const Choices<hfo::Referee>& referee_choices();
 const Choices<hfo::BodyAtReset>& body_at_reset_choices();
+const Choices<std::string>& env_choices();
+const Choices<hfo_server::Encoding>& server_encoding_choices();
 
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws
 // std::runtime_error with the key, the problem and the valid choices.

@@ -76,7 +76,7 @@ void run_learner(const LearnerCliOptions& o) {
   }
 
   auto env = make_env(c.env);
-  auto eval_env = make_env(c.env);
+  auto eval_env = make_eval_env(c);
   const ExplorationConfig exploration = resolve_exploration(c, env->action_space());
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   CheckpointMeta meta;

@@ -88,7 +88,7 @@ class Trainer {
       : c_(c),
         o_(std::move(o)),
         env_(make_env(c.env)),
-        eval_env_(make_env(c.env)),
+        eval_env_(make_eval_env(c)),
         space_(env_->action_space()),
         exploration_(resolve_exploration(c, space_)),
         obs_dim_(env_->observation_size()),
