@@ -1,0 +1,310 @@
+// The real HFO server's features (E3, shared/hfo-reference.md §3.4) converted to the embedded
+// encoding (E1/E2, §3.2), the hfo-server config keys, and env creation in builds with and without
+// HFO. Needs no server: tests/hfo_server_live_test.cpp plays against a real one.
+//
+// E3 normalizers: R3 = sqrt(52.5^2 + 68^2) = sqrt(7380.25) = 85.9083814; OOB 1.1 * 52.5 = 57.75
+// (left, right) and 1.05 * 68 = 71.4 (top, bottom). E1/E2: R1 = sqrt(52.5^2 + 34^2) = 62.5479816,
+// OOB 52.5 and 68. A proximity is 1 - 2 clamp(d / M, 0, 1).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/env_factory.hpp"
+#include "app/experiment_config.hpp"
+#include "core/rng.hpp"
+#include "envs/hfo/features.hpp"
+#include "envs/hfo/soccer_sim.hpp"
+#include "envs/hfo_server/feature_encoding.hpp"
+#include "envs/hfo_server/hfo_server_env.hpp"
+
+namespace pamdp::hfo_server {
+namespace {
+
+constexpr double kTol = 2e-6;
+const double kR3 = std::sqrt(52.5 * 52.5 + 68.0 * 68.0);
+
+double e3_prox(double d, double max) {
+  return 1.0 - 2.0 * std::clamp(d / max, 0.0, 1.0);
+}
+
+// The 11 landmarks of features 13-45, in feature order (reference §3.2).
+const std::array<hfo::Vec2, 11> kLandmarks{{{52.5, 0.0},
+                                            {52.5, -7.01},
+                                            {52.5, 7.01},
+                                            {36.0, 0.0},
+                                            {36.0, -20.16},
+                                            {36.0, 20.16},
+                                            {0.0, 0.0},
+                                            {0.0, -34.0},
+                                            {52.5, -34.0},
+                                            {52.5, 34.0},
+                                            {0.0, 34.0}}};
+
+hfo::SoccerState state_1v0(hfo::Vec2 agent, double body_deg, hfo::Vec2 ball, hfo::Vec2 ball_vel = {}) {
+  hfo::SoccerState s;
+  s.num_players = 1;
+  s.players[0].pos = agent;
+  s.players[0].body_deg = body_deg;
+  s.ball.pos = ball;
+  s.ball.vel = ball_vel;
+  s.prev_ball = ball;
+  return s;
+}
+
+// What the real server sends for `s` (1v0 or with a goalie): the values the two encodings share
+// come from the embedded writer; every proximity is recomputed here from the geometry with the E3
+// normalizers, independently of the code under test; then the uniform numbers and the
+// last-action flag.
+std::vector<float> e3_of(const hfo::SoccerState& s, float last_action = 1.0F) {
+  const int others = s.num_players - 1;
+  std::vector<float> e1(static_cast<size_t>(hfo::feature_count(s.num_players)));
+  hfo::write_features(s, e1);
+  std::vector<float> e3(static_cast<size_t>(e3_feature_count(0, others)));
+  std::copy(e1.begin(), e1.end(), e3.begin());
+  const hfo::Vec2 p = s.players[0].pos;
+  for (size_t k = 0; k < kLandmarks.size(); ++k) {
+    e3[hfo::feat::kGoalCentre + 3 * k + 2] = static_cast<float>(e3_prox((kLandmarks[k] - p).r(), kR3));
+  }
+  e3[hfo::feat::kOobLeft] = static_cast<float>(e3_prox(p.x, 57.75));
+  e3[hfo::feat::kOobRight] = static_cast<float>(e3_prox(52.5 - p.x, 57.75));
+  e3[hfo::feat::kOobTop] = static_cast<float>(e3_prox(34.0 + p.y, 71.4));
+  e3[hfo::feat::kOobBottom] = static_cast<float>(e3_prox(34.0 - p.y, 71.4));
+  e3[hfo::feat::kBallProximity] = static_cast<float>(e3_prox((s.ball.pos - p).r(), kR3));
+  for (int k = 0; k < others; ++k) {
+    const hfo::PlayerState& o = s.players[static_cast<size_t>(1 + k)];
+    const bool present = o.pos.x > 0.0;
+    const size_t b = hfo::kNumAgentFeatures + static_cast<size_t>(hfo::kFeaturesPerPlayer * k);
+    if (present) {
+      e3[b + 2] = static_cast<float>(e3_prox((o.pos - p).r(), kR3));
+    }
+    e3[hfo::kNumAgentFeatures + static_cast<size_t>(hfo::kFeaturesPerPlayer * others + k)] = present ? 0.01F : -1.0F;
+  }
+  e3.back() = last_action;
+  return e3;
+}
+
+std::vector<float> converted(const std::vector<float>& e3, int opponents) {
+  std::vector<float> out(static_cast<size_t>(hfo::feature_count(1 + opponents)), -7.0F);  // sentinel
+  e3_to_embedded(e3, 0, opponents, out);
+  return out;
+}
+
+TEST(HfoServerFeatures, CountsOfCurrentHfo) {
+  EXPECT_EQ(e3_feature_count(0, 0), 59);  // reference §3.4, measured in §9
+  EXPECT_EQ(e3_feature_count(0, 1), 68);
+  EXPECT_EQ(e3_feature_count(1, 1), 77);
+  EXPECT_EQ(e3_last_action_index(0, 0), 58);
+  EXPECT_NEAR(e3_max_distance(), 85.9083814, 1e-4);
+  EXPECT_FLOAT_EQ(kE3OobLength, 57.75F);
+  EXPECT_FLOAT_EQ(kE3OobWidth, 71.4F);
+}
+
+// Reference §3.2's worked example, as the real server encodes it, converted back. Agent at (0, 0),
+// body 0, at rest; ball at (10, 0).
+//   ball: E3 1 - 20/85.9083814 = 0.7671938 -> E1 1 - 20/62.5479816 = 0.6802455.
+//   goal centre: E3 1 - 105/85.9083814 = -0.2222323 -> E1 1 - 105/62.5479816 = -0.6787112.
+//   corner top-right (52.5, -34): d = R1 = 62.5479816, E3 1 - 125.0959632/85.9083814 = -0.4561555
+//     -> E1 exactly -1.
+//   corner top-left (0, -34): E3 1 - 68/85.9083814 = 0.2084591 -> E1 1 - 68/62.5479816 = -0.0871654.
+//   OOB left d = 0: +1 in both. OOB right d = 52.5: E3 1 - 105/57.75 = -0.8181818 -> E1 -1.
+//   OOB top/bottom d = 34: E3 1 - 68/71.4 = 0.0476190 -> E1 1 - 68/68 = 0.
+TEST(HfoServerFeatures, WorkedExampleReencodedInE3ConvertsBack) {
+  std::vector<float> e3 = e3_of(state_1v0({0.0, 0.0}, 0.0, {10.0, 0.0}));
+  ASSERT_EQ(e3.size(), 59U);
+  EXPECT_NEAR(e3[53], 0.7671938, kTol);
+  EXPECT_NEAR(e3[15], -0.2222323, kTol);
+  EXPECT_NEAR(e3[39], -0.4561555, kTol);
+  EXPECT_NEAR(e3[36], 0.2084591, kTol);
+  EXPECT_NEAR(e3[47], -0.8181818, kTol);
+  EXPECT_NEAR(e3[48], 0.0476190, kTol);
+
+  const std::vector<float> f = converted(e3, 0);
+  EXPECT_NEAR(f[53], 0.6802455, kTol);
+  EXPECT_NEAR(f[51], 0.0, kTol);
+  EXPECT_NEAR(f[52], 1.0, kTol);
+  EXPECT_NEAR(f[15], -0.6787112, kTol);
+  EXPECT_NEAR(f[39], -1.0, kTol);
+  EXPECT_NEAR(f[36], -0.0871654, kTol);
+  EXPECT_NEAR(f[46], 1.0, kTol);
+  EXPECT_NEAR(f[47], -1.0, kTol);
+  EXPECT_NEAR(f[48], 0.0, kTol);
+  EXPECT_NEAR(f[49], 0.0, kTol);
+  EXPECT_NEAR(f[5], 0.0, kTol);
+  EXPECT_NEAR(f[6], 1.0, kTol);
+}
+
+// Over random 1v0 states the conversion gives exactly what the embedded simulator writes for the
+// same state, in every one of the 58 values (positions as far as 8 m outside the field, so
+// distances beyond R1 saturate).
+TEST(HfoServerFeatures, RandomStatesMatchTheEmbeddedEncoding) {
+  Rng rng(17);
+  for (int i = 0; i < 2000; ++i) {
+    const hfo::Vec2 agent{rng.uniform(-8.0, 60.0), rng.uniform(-40.0, 40.0)};
+    const hfo::Vec2 ball{rng.uniform(-2.0, 55.0), rng.uniform(-35.0, 35.0)};
+    const hfo::Vec2 ball_vel{rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)};
+    const hfo::SoccerState s = state_1v0(agent, rng.uniform(-180.0, 180.0), ball, ball_vel);
+    std::vector<float> want(58);
+    hfo::write_features(s, want);
+    const std::vector<float> got = converted(e3_of(s), 0);
+    for (size_t k = 0; k < want.size(); ++k) {
+      ASSERT_NEAR(got[k], want[k], kTol) << "feature " << k << ", agent (" << agent.x << ", " << agent.y << ")";
+    }
+  }
+}
+
+// With a goalie the opponent block keeps its layout and its proximity is re-encoded; the uniform
+// numbers and the last-action flag are dropped (68 -> 66).
+TEST(HfoServerFeatures, OpponentBlockIsReencodedAndTheTailDropped) {
+  hfo::SoccerState s = state_1v0({20.0, 5.0}, 30.0, {22.0, 4.0});
+  s.num_players = 2;
+  s.players[1].pos = {50.0, -1.0};
+  s.players[1].body_deg = 180.0;
+  s.players[1].vel = {-0.2, 0.1};
+  s.players[1].team = hfo::Team::kDefense;
+  s.players[1].goalie = true;
+  const std::vector<float> e3 = e3_of(s, -1.0F);
+  ASSERT_EQ(e3.size(), 68U);
+  std::vector<float> want(66);
+  hfo::write_features(s, want);
+  const std::vector<float> got = converted(e3, 1);
+  ASSERT_EQ(got.size(), 66U);
+  for (size_t k = 0; k < want.size(); ++k) {
+    EXPECT_NEAR(got[k], want[k], kTol) << "feature " << k;
+  }
+  // d = sqrt(30^2 + 6^2) = 30.5941171: E1 1 - 61.1882343/62.5479816 = 0.0217393.
+  EXPECT_NEAR(got[58 + 2], 0.0217393, kTol);
+}
+
+// An empty opponent slot is zeros in both encodings (its uniform number is -1), not a player at
+// distance R3/2 whose proximity happens to be 0.
+TEST(HfoServerFeatures, EmptyOpponentSlotStaysZero) {
+  hfo::SoccerState s = state_1v0({20.0, 5.0}, 30.0, {22.0, 4.0});
+  s.num_players = 2;
+  s.players[1].pos = {-5.0, 0.0};  // x <= 0: not in the HFO area, not listed
+  s.players[1].team = hfo::Team::kDefense;
+  const std::vector<float> e3 = e3_of(s);
+  ASSERT_EQ(e3[58 + 8], -1.0F);
+  const std::vector<float> got = converted(e3, 1);
+  for (int k = 58; k < 66; ++k) {
+    EXPECT_EQ(got[static_cast<size_t>(k)], 0.0F) << "feature " << k;
+  }
+  // A listed opponent exactly R3/2 = 42.954 m away has E3 proximity 0 and is re-encoded:
+  // E1 1 - 85.9083814/62.5479816 = -0.3734797.
+  std::vector<float> e3_present = e3;
+  e3_present[58 + 2] = 0.0F;
+  e3_present[58 + 8] = 0.01F;
+  EXPECT_NEAR(converted(e3_present, 1)[58 + 2], -0.3734797, kTol);
+}
+
+// Without a valid self position HFO zeroes every landmark and OOB value; they stay zero.
+TEST(HfoServerFeatures, ValuesZeroedByAnInvalidFlagStayZero) {
+  std::vector<float> e3(59, 0.0F);
+  e3[0] = -1.0F;   // self position invalid
+  e3[50] = -1.0F;  // ball position invalid
+  e3[58] = 1.0F;
+  const std::vector<float> got = converted(e3, 0);
+  for (int k = 13; k < 58; ++k) {
+    if (k != 50) {
+      EXPECT_EQ(got[static_cast<size_t>(k)], 0.0F) << "feature " << k;
+    }
+  }
+}
+
+// The config keys of the real-server env: defaults, validation, round trip.
+TEST(HfoServerConfig, KeysAreValidatedAndRoundTrip) {
+  const app::ExperimentConfig def = app::parse_experiment_config("", "defaults", {});
+  EXPECT_EQ(def.env.server_host, "localhost");
+  EXPECT_EQ(def.env.server_port, 6000);
+  EXPECT_EQ(def.env.server_eval_port, 0);
+  EXPECT_EQ(def.env.server_encoding, Encoding::kNative);
+  EXPECT_EQ(def.env.server_team, "base_left");
+  EXPECT_EQ(def.env.server_config_dir, "");
+
+  const app::ExperimentConfig c = app::parse_experiment_config(
+      "", "x",
+      {"env.name=hfo-server", "env.server_host=10.0.0.7", "env.server_port=7000", "env.server_eval_port=7010",
+       "env.server_encoding=embedded", "env.server_config_dir=/opt/HFO/bin/teams/base/config/formations-dt"});
+  EXPECT_EQ(c.env.name, "hfo-server");
+  EXPECT_EQ(c.env.server_port, 7000);
+  EXPECT_EQ(c.env.server_encoding, Encoding::kEmbedded);
+  const app::ExperimentConfig back = app::parse_experiment_config(app::to_toml(c), "round-trip", {});
+  EXPECT_EQ(app::to_toml(back), app::to_toml(c));
+  EXPECT_EQ(back.env.server_config_dir, "/opt/HFO/bin/teams/base/config/formations-dt");
+
+  const auto error_of = [](const std::string& set) {
+    try {
+      app::parse_experiment_config("", "cfg", {set});
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of("env.server_port=0").find("'env.server_port' must be within [1, 65535]"), std::string::npos);
+  EXPECT_NE(error_of("env.server_port=70000").find("env.server_port"), std::string::npos);
+  EXPECT_NE(error_of("env.server_encoding=e3").find("native, embedded"), std::string::npos);
+  EXPECT_NE(error_of("env.server_host=''").find("'env.server_host' must be a non-empty string"), std::string::npos);
+  EXPECT_NE(error_of("env.name=hfo_server").find("hfo, reach_stop, hfo-server"), std::string::npos);
+  EXPECT_NE(error_of("env.server_prot=7000").find("server_port"), std::string::npos);  // lists the valid keys
+}
+
+// Widths come from the env: 59 native / 58 embedded in 1v0, 68 / 66 with a goalie.
+TEST(HfoServerEnv, ObservationSizesComeFromTheConfig) {
+  app::EnvConfig e;
+  e.name = "hfo-server";
+  EXPECT_EQ(app::observation_size(e), 59);
+  e.server_encoding = Encoding::kEmbedded;
+  EXPECT_EQ(app::observation_size(e), 58);
+  e.hfo.goalie = true;
+  EXPECT_EQ(app::observation_size(e), 66);
+  e.server_encoding = Encoding::kNative;
+  EXPECT_EQ(app::observation_size(e), 68);
+}
+
+// Without HFO the env name is known but making one names the fix; with HFO, making one opens no
+// connection (the learner and shards make one only for its sizes).
+TEST(HfoServerEnv, CreationWithoutHfoNamesTheFixAndWithHfoDoesNotConnect) {
+  app::EnvConfig e;
+  e.name = "hfo-server";
+  e.server_port = 1;  // nothing listens there
+  if (!built_with_hfo()) {
+    try {
+      (void)app::make_env(e);
+      FAIL() << "made an hfo-server env without HFO";
+    } catch (const std::runtime_error& err) {
+      EXPECT_NE(std::string(err.what()).find("rebuild with -DHFO_ROOT=/path/to/HFO"), std::string::npos) << err.what();
+    }
+    return;
+  }
+  const std::unique_ptr<Env> env = app::make_env(e);
+  EXPECT_EQ(env->name(), "hfo-server");
+  EXPECT_EQ(env->observation_size(), 59);
+  EXPECT_EQ(env->action_space().num_actions(), 4);
+  EXPECT_EQ(env->max_episode_steps(), 501);
+  EXPECT_EQ(env->status_name(env->success_status()), "GOAL");
+}
+
+// Greedy evaluations of train / learner need a server of their own, asked for at start-up.
+TEST(HfoServerEnv, EvaluationsNeedTheirOwnServer) {
+  app::ExperimentConfig c = app::parse_experiment_config("", "x", {"env.name=hfo-server", "env.server_port=7000"});
+  if (!built_with_hfo()) {
+    GTEST_SKIP() << "no HFO in this build";
+  }
+  try {
+    (void)app::make_eval_env(c);
+    FAIL() << "evaluations on the acting server were accepted";
+  } catch (const std::runtime_error& err) {
+    EXPECT_NE(std::string(err.what()).find("env.server_eval_port"), std::string::npos) << err.what();
+  }
+  c.train.eval_episodes = 0;
+  EXPECT_NO_THROW((void)app::make_eval_env(c));
+  c.train.eval_episodes = 10;
+  c.env.server_eval_port = 7010;
+  EXPECT_NO_THROW((void)app::make_eval_env(c));
+}
+
+}  // namespace
+}  // namespace pamdp::hfo_server
