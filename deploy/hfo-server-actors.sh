@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# Runs N actors of a learner on the real HFO server, one HFO server per actor (docs/hfo-server.md):
+# actor i gets bin/HFO on port BASE + 10 i (HFO also takes the next two ports for its coaches) and
+# joins once that server waits for its agent. A server ends its game when its actor leaves, so
+# the two are restarted together if either stops. Ctrl-C stops them all.
+#
+#   deploy/hfo-server-actors.sh --hfo-root DIR --join tcp://LEARNER:5555 [--actors N]
+#                               [--base-port P] [--seed S] [--log-dir DIR] [--goalie]
+#
+# Defaults: 1 actor, base port 7000, seed 1 (server i of restart r: S + 100 i + r), logs in
+# runs/hfo-servers. The learner runs with --set env.name=hfo-server (and train.eval_episodes=0,
+# or env.server_eval_port with a server of its own); with --goalie each server gets one goalie
+# (--defense-npcs 1) and the learner needs env.goalie=true. PAMDP_BIN picks the pamdp binary
+# (default build/bin/pamdp; it must be built with -DHFO_ROOT).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+
+hfo_root=""
+join=""
+actors=1
+base_port=7000
+seed=1
+log_dir=runs/hfo-servers
+goalie=0
+
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+die() { echo "hfo-server-actors: $*" >&2; exit 2; }
+need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
+
+while [[ $# -gt 0 ]]; do
+  case $1 in
+    --hfo-root) need_value "$@"; hfo_root=$2; shift 2 ;;
+    --join) need_value "$@"; join=$2; shift 2 ;;
+    --actors) need_value "$@"; actors=$2; shift 2 ;;
+    --base-port) need_value "$@"; base_port=$2; shift 2 ;;
+    --seed) need_value "$@"; seed=$2; shift 2 ;;
+    --log-dir) need_value "$@"; log_dir=$2; shift 2 ;;
+    --goalie) goalie=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) die "unknown option '$1' (see --help)" ;;
+  esac
+done
+[[ -n $hfo_root ]] || die "--hfo-root is required (the HFO build: bin/HFO, bin/rcssserver)"
+[[ -x $hfo_root/bin/HFO && -x $hfo_root/bin/rcssserver ]] || die "no bin/HFO and bin/rcssserver in '$hfo_root' (run make install in HFO's build)"
+[[ -n $join ]] || die "--join is required (the learner's join endpoint, tcp://HOST:PORT)"
+[[ $actors =~ ^[0-9]+$ && $actors -ge 1 ]] || die "--actors must be a positive integer, got '$actors'"
+[[ $base_port =~ ^[0-9]+$ && $base_port -ge 1024 && $((base_port + 10 * actors)) -le 65535 ]] ||
+  die "--base-port must leave room for $actors servers 10 ports apart below 65536, got '$base_port'"
+[[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, got '$seed'"
+bin=${PAMDP_BIN:-$root/build/bin/pamdp}
+[[ -x $bin ]] || die "no pamdp binary at $bin (build with -DHFO_ROOT, or set PAMDP_BIN)"
+py=""
+for candidate in python3 /usr/bin/python3 python; do
+  if command -v "$candidate" >/dev/null && "$candidate" -c 'import numpy' 2>/dev/null; then
+    py=$candidate
+    break
+  fi
+done
+[[ -n $py ]] || die "bin/HFO needs a Python with numpy (apt-get install python3-numpy)"
+mkdir -p "$log_dir"
+defense=()
+((goalie == 0)) || defense=(--defense-npcs 1)
+
+# One actor and its server, restarted together until this subshell is told to stop.
+run_pair() {
+  local i=$1 port=$((base_port + 10 * $1)) restart=0 server="" actor="" stopping=0
+  trap 'stopping=1; [[ -z $actor ]] || kill -TERM "$actor" 2>/dev/null; [[ -z $server ]] || kill -TERM -- "-$server" 2>/dev/null' TERM INT
+  while ((stopping == 0)); do
+    local log=$log_dir/hfo-$port.log
+    setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 "${defense[@]}" --headless --fullstate --no-logging \
+      --frames-per-trial 500 --port "$port" --seed $((seed + 100 * i + restart)) >"$log" 2>&1 &
+    server=$!
+    until grep -q "Waiting for player-controlled agent" "$log" 2>/dev/null; do
+      kill -0 "$server" 2>/dev/null || { echo "hfo-server-actors: server on port $port exited; see $log" >&2; break; }
+      sleep 0.2
+    done
+    if kill -0 "$server" 2>/dev/null && ((stopping == 0)); then
+      "$bin" actor --join "$join" --server-port "$port" --seed $((1000 + i)) --name "hfo-actor-$i" \
+        >>"$log_dir/actor-$i.log" 2>&1 &
+      actor=$!
+      wait "$actor" || true
+      wait "$actor" 2>/dev/null || true  # a trap interrupts the first wait
+      actor=""
+    fi
+    kill -TERM -- "-$server" 2>/dev/null || true
+    wait "$server" 2>/dev/null || true
+    server=""
+    restart=$((restart + 1))
+    ((stopping == 1)) || sleep 1
+  done
+}
+
+pairs=()
+stop_all() {
+  trap - INT TERM EXIT
+  echo "hfo-server-actors: stopping ${#pairs[@]} actors and their servers..." >&2
+  for p in "${pairs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+}
+trap stop_all INT TERM EXIT
+
+for ((i = 0; i < actors; i++)); do
+  run_pair "$i" &
+  pairs+=($!)
+  echo "actor $i: HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i.log"
+done
+echo "hfo-server-actors: $actors actors joining $join; Ctrl-C stops them and their servers"
+wait
