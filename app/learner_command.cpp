@@ -98,6 +98,7 @@ void run_learner(const LearnerCliOptions& o) {
   sc.peer_timeout_ms = c.cluster.peer_timeout_ms;
   sc.max_updates = c.train.max_updates;
   sc.max_seconds = c.train.max_seconds;
+  sc.weights_version = meta.weights_version;
   o.apply_metrics_overrides(c);
   MetricsEndpoint endpoint("learner", "learner", c.metrics.bind, c.metrics.port, c.cluster.advertise_host);
   LearnerMetrics learner_metrics(endpoint.registry(), *env, exploration);
@@ -142,6 +143,7 @@ void run_learner(const LearnerCliOptions& o) {
     meta.elapsed_seconds = elapsed();
     meta.episodes = episode_count;
     meta.env_steps = env_steps;
+    meta.weights_version = server.counters().weights_version;
     backend->sync_to_host();
     save_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg, meta);
     last_checkpoint = elapsed();

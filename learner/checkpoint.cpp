@@ -124,6 +124,7 @@ void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& 
   b.add_rng_states(rngs);
   b.add_elapsed_seconds(meta.elapsed_seconds);
   b.add_update_credit(meta.update_credit);
+  b.add_weights_version(meta.weights_version);
   wire::FinishCheckpointBuffer(fbb, b.Finish());
   const uint64_t sum = fnv1a64(fbb.GetBufferPointer(), fbb.GetSize());
   uint8_t trailer[kTrailerSize];
@@ -155,6 +156,7 @@ CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {
   meta.episodes = ck->episodes();
   meta.elapsed_seconds = ck->elapsed_seconds();
   meta.update_credit = ck->update_credit();
+  meta.weights_version = ck->weights_version();
   if (const auto* r = ck->rng_states()) {
     // FlatBuffers 2.0's verifier does not check the alignment of 8-byte elements.
     if (r->size() % 4 != 0 || (r->size() > 0 && reinterpret_cast<uintptr_t>(r->data()) % alignof(uint64_t) != 0)) {

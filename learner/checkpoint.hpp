@@ -20,7 +20,8 @@ struct CheckpointMeta {
   int64_t env_steps = 0;
   int64_t episodes = 0;
   double elapsed_seconds = 0.0;
-  double update_credit = 0.0;  // fractional updates owed (train.updates_per_step < 1)
+  double update_credit = 0.0;   // fractional updates owed (train.updates_per_step < 1)
+  int64_t weights_version = 0;  // last policy version published (pamdp learner; 0 in older files)
   std::vector<std::array<uint64_t, 4>> rng_states;
 };
 

@@ -46,6 +46,7 @@ LearnerServer::LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerS
   join_.set_max_message_bytes(1 << 20);
   join_.set_recv_hwm(10000);
   weights_.set_send_hwm(4);  // slow subscribers get the newest weights, not a backlog
+  counters_.weights_version = config_.weights_version;
   if (config_.curve) {
     join_.make_curve_server(*config_.curve);
     weights_.make_curve_server(*config_.curve);

@@ -42,6 +42,7 @@ struct LearnerServerConfig {
   std::string metrics_url;                           // this learner's own, first in metrics_urls()
   std::optional<net::CurveServerKeys> curve;         // CURVE on both bound sockets when set
   std::optional<net::CurveClientKeys> curve_client;  // for the learner's own connections to shards
+  int64_t weights_version = 0;                       // last version published (a resumed run goes on from it)
 };
 
 struct LearnerCounters {

@@ -86,7 +86,9 @@ cp "$work/run/checkpoint.ckpt" "$work/killed.ckpt"
 (cd "$work" && flatc --json --strict-json --raw-binary "$src/schemas/checkpoint.fbs" -- killed.ckpt)
 ck_updates=$(grep -o '"updates": *[0-9]*' "$work/killed.json" | grep -o '[0-9]*$' || echo 0)
 ck_episodes=$(grep -o '"episodes": *[0-9]*' "$work/killed.json" | grep -o '[0-9]*$' || echo 0)
+ck_version=$(grep -o '"weights_version": *[0-9]*' "$work/killed.json" | grep -o '[0-9]*$' || echo 0)
 ((ck_updates > 0)) || fail "the checkpoint holds no updates"
+((ck_version > 0)) || fail "the checkpoint holds no weights version"
 old_join=$join
 start_learner learner-resumed --resume "$work/run" \
   --set "cluster.learner_bind=$old_join" --set "cluster.weights_bind=$weights"
@@ -101,8 +103,10 @@ for p in shard0 shard1 actor0 actor1; do
 done
 updates_grow "learner resumed" 200
 # Only the resumed learner can have sent the actor other weights since.
-wait_for 20 "actor 1 got no weights from the resumed learner (still v$actor1_version)" \
-  '[[ $(metric "${aurl[1]}" pamdp_actor_weights_version) != "$actor1_version" ]]'
+# The resumed learner numbers its weights on from the checkpoint's version (versions never go
+# back, so episodes.csv's weights_version stays monotonic across a restart).
+wait_for 20 "actor 1 got no weights from the resumed learner (still v$actor1_version, checkpoint v$ck_version)" \
+  'gt "$(metric "${aurl[1]}" pamdp_actor_weights_version)" "$ck_version"'
 # metrics.csv: the resumed learner's rows go on from the checkpoint's counters.
 column() {
   awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i } END { if (c) print $c }' "$work/run/metrics.csv"
@@ -110,7 +114,7 @@ column() {
 wait_for 10 "metrics.csv has no row from the resumed learner" 'ge "$(column updates)" "$first"'
 csv_episodes=$(column episodes)
 ge "$csv_episodes" "$ck_episodes" || fail "episodes $csv_episodes after resume, the checkpoint had $ck_episodes"
-echo "learner: kill -9 at checkpoint updates $ck_updates, episodes $ck_episodes -> resumed at $first updates, episodes $csv_episodes, same 2 shards + 2 actors back (actor 1 weights v$actor1_version -> v$(metric "${aurl[1]}" pamdp_actor_weights_version)), updates now $(updates) at $(since)"
+echo "learner: kill -9 at checkpoint updates $ck_updates, episodes $ck_episodes, weights v$ck_version -> resumed at $first updates, episodes $csv_episodes, same 2 shards + 2 actors back (actor 1 weights v$actor1_version -> v$(metric "${aurl[1]}" pamdp_actor_weights_version)), updates now $(updates) at $(since)"
 
 # --- SIGTERM: a resumable run directory ---------------------------------------------------------
 kill -TERM "${pid[learner]}"
