@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <thread>
@@ -28,6 +29,17 @@ inline constexpr uint32_t kWidth = 3;                                  // MOVE, 
 inline constexpr const char* kConfigToml = "[env]\nname = \"reach_stop\"\n";
 
 using Bytes = std::vector<uint8_t>;
+
+// Deadlines in these tests are multiplied by PAMDP_TEST_TIME_SCALE (default 1): sanitizer builds
+// run many times slower (tests/sanitize.sh --thread sets 10).
+inline int scaled_ms(int ms) {
+  static const int scale = [] {
+    const char* s = std::getenv("PAMDP_TEST_TIME_SCALE");
+    const int v = s != nullptr ? std::atoi(s) : 1;
+    return v >= 1 ? v : 1;
+  }();
+  return ms * scale;
+}
 
 inline Bytes copy_bytes(std::span<const uint8_t> b) {
   return {b.begin(), b.end()};
@@ -189,7 +201,7 @@ inline ActorLoopConfig test_loop_config() {
   c.gamma = 0.9;
   c.batch_transitions = 64;
   c.heartbeat_ms = 20;
-  c.peer_timeout_ms = 1000;
+  c.peer_timeout_ms = scaled_ms(1000);
   c.tick_ms = 20;
   c.seed = 7;
   return c;
@@ -242,7 +254,7 @@ class ActorRunner {
 // Serves the fakes until `done()` holds or timeout_ms passes; returns done().
 template <typename Done>
 bool serve_until(FakeLearner& learner, std::vector<FakeShard*> shards, Done done, int timeout_ms = 2500) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(scaled_ms(timeout_ms));
   while (!done()) {
     if (std::chrono::steady_clock::now() >= deadline) {
       return false;

@@ -21,7 +21,7 @@ if [[ ${1:-} == --thread ]]; then
   status=0
   for t in "${threaded[@]}"; do
     echo "sanitize --thread: $t"
-    TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp" "build-tsan/bin/$t" --gtest_brief=1 "$@" || status=1
+    PAMDP_TEST_TIME_SCALE=10 TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp" "build-tsan/bin/$t" --gtest_brief=1 "$@" || status=1
   done
   ((status == 0)) || { echo "sanitize --thread: ThreadSanitizer or a test failed (above)" >&2; exit 1; }
   echo "sanitize --thread: ${threaded[*]} clean under ThreadSanitizer"
