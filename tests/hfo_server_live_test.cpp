@@ -44,16 +44,17 @@ void check_geometry(const std::vector<float>& f, int step) {
   const double y = y_top - hfo::kPitchHalfWidth;
   ASSERT_NEAR(x, hfo::kPitchHalfLength - x_right, kMetreTol) << "step " << step;
   ASSERT_NEAR(y, hfo::kPitchHalfWidth - y_bottom, kMetreTol) << "step " << step;
-  const struct {
-    int index;
+  struct Landmark {
+    int index = 0;
     hfo::Vec2 at;
-  } landmarks[] = {{hfo::feat::kGoalCentre, {52.5, 0.0}},
-                   {hfo::feat::kPenaltyTop, {36.0, -20.16}},
-                   {hfo::feat::kCentreField, {0.0, 0.0}},
-                   {hfo::feat::kCornerTopLeft, {0.0, -34.0}},
-                   {hfo::feat::kCornerBottomRight, {52.5, 34.0}}};
+  };
+  const Landmark landmarks[] = {{hfo::feat::kGoalCentre, {52.5, 0.0}},
+                                {hfo::feat::kPenaltyTop, {36.0, -20.16}},
+                                {hfo::feat::kCentreField, {0.0, 0.0}},
+                                {hfo::feat::kCornerTopLeft, {0.0, -34.0}},
+                                {hfo::feat::kCornerBottomRight, {52.5, 34.0}}};
   for (const auto& l : landmarks) {
-    const double d = distance(f[static_cast<size_t>(l.index + 2)], hfo::kMaxDistance);
+    const double d = distance(f[static_cast<size_t>(l.index) + 2], hfo::kMaxDistance);
     if (d >= 0.0) {
       ASSERT_NEAR(d, (l.at - hfo::Vec2{x, y}).r(), kMetreTol) << "landmark at feature " << l.index << ", step " << step;
     }

@@ -74,14 +74,15 @@ std::vector<float> e3_of(const hfo::SoccerState& s, float last_action = 1.0F) {
   e3[hfo::feat::kOobTop] = static_cast<float>(e3_prox(34.0 + p.y, 71.4));
   e3[hfo::feat::kOobBottom] = static_cast<float>(e3_prox(34.0 - p.y, 71.4));
   e3[hfo::feat::kBallProximity] = static_cast<float>(e3_prox((s.ball.pos - p).r(), kR3));
+  const size_t unum_base = e3.size() - 1 - static_cast<size_t>(others);  // then one uniform number each
   for (int k = 0; k < others; ++k) {
-    const hfo::PlayerState& o = s.players[static_cast<size_t>(1 + k)];
+    const hfo::PlayerState& o = s.players[static_cast<size_t>(k) + 1];
     const bool present = o.pos.x > 0.0;
-    const size_t b = hfo::kNumAgentFeatures + static_cast<size_t>(hfo::kFeaturesPerPlayer * k);
+    const size_t b = hfo::kNumAgentFeatures + static_cast<size_t>(hfo::kFeaturesPerPlayer) * static_cast<size_t>(k);
     if (present) {
       e3[b + 2] = static_cast<float>(e3_prox((o.pos - p).r(), kR3));
     }
-    e3[hfo::kNumAgentFeatures + static_cast<size_t>(hfo::kFeaturesPerPlayer * others + k)] = present ? 0.01F : -1.0F;
+    e3[unum_base + static_cast<size_t>(k)] = present ? 0.01F : -1.0F;
   }
   e3.back() = last_action;
   return e3;
