@@ -65,7 +65,7 @@ extern "C" void explain_exit_while_connecting() {
 
 // rcssserver answers any unknown datagram on its player port with "(error unknown_command)", so
 // one probe tells whether a server listens there without joining its game. Retried every 0.5 s
-// for `wait_s` seconds (a server that is still starting up answers late).
+// for `connect_wait_s` seconds (a server that is still starting up answers late).
 void probe_server(const HfoServerConfig& c) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
