@@ -82,6 +82,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("train.eval_episodes", c.train.eval_episodes, 0, 1000000);
   v.real("train.checkpoint_every_seconds", c.train.checkpoint_every_seconds, 0.0, 1e9);
   v.real("train.log_every_seconds", c.train.log_every_seconds, 0.0, 1e9);
+  v.text_or_empty("train.init_from", c.train.init_from);
 
   v.text("cluster.learner_bind", c.cluster.learner_bind);
   v.text("cluster.weights_bind", c.cluster.weights_bind);

@@ -73,6 +73,9 @@ struct TrainLoopConfig {
   int eval_episodes = 10;
   double checkpoint_every_seconds = 600.0;
   double log_every_seconds = 10.0;
+  // Warm start: a checkpoint whose networks a new run starts from (learner/checkpoint.hpp
+  // warm_start_from_checkpoint; e.g. a 1v0 agent continued against the goalie). Empty: from scratch.
+  std::string init_from;
 };
 
 struct ExperimentConfig {

@@ -82,6 +82,9 @@ void run_learner(const LearnerCliOptions& o) {
   CheckpointMeta meta;
   if (resume) {
     meta = load_checkpoint((fs::path(run_dir) / "checkpoint.ckpt").string(), ddpg);
+  } else if (!c.train.init_from.empty()) {
+    warm_start_from_checkpoint(c.train.init_from, ddpg);
+    log::info("learner: networks warm-started from {}", c.train.init_from);
   }
   meta.config_toml = config_text;
   // Built after the checkpoint is loaded: a GPU backend starts from the host state.

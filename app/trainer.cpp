@@ -18,6 +18,7 @@
 #include "app/run_logs.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
+#include "core/log.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/update_backend.hpp"
@@ -288,6 +289,11 @@ TrainSummary Trainer::run() {
   if (o_.resume) {
     resume();
   } else {
+    if (!c_.train.init_from.empty()) {
+      warm_start_from_checkpoint(c_.train.init_from, ddpg_);
+      backend_->load_from_host();
+      log::info("train: networks warm-started from {}", c_.train.init_from);
+    }
     const std::string text = to_toml(c_);
     write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
   }

@@ -169,6 +169,71 @@ CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {
   return meta;
 }
 
+namespace {
+
+std::vector<int> widths_of(const flatbuffers::Vector<int32_t>* v) {
+  return v != nullptr ? std::vector<int>(v->begin(), v->end()) : std::vector<int>{};
+}
+
+std::string join_widths(const std::vector<int>& w) {
+  std::string s;
+  for (const int x : w) {
+    s += (s.empty() ? "" : "-") + std::to_string(x);
+  }
+  return s;
+}
+
+// Copies `src` (flat parameters of a network with widths `from`) into `dst`, whose first layer
+// has `extra` more inputs inserted after the first `kept` ones (zero weights); every other layer
+// is copied as is.
+void widen_into(const flatbuffers::Vector<float>* src, const std::vector<int>& from, int kept, int extra,
+                Mlp<float>& dst, const char* what, const std::string& path) {
+  Mlp<float> old(from, 1);
+  copy_into(src, old.params(), what, path);
+  auto w0 = dst.weight(0);
+  const auto o0 = old.weight(0);
+  const int rest = o0.cols() - kept;
+  w0.leftCols(kept) = o0.leftCols(kept);
+  w0.middleCols(kept, extra).setZero();
+  w0.rightCols(rest) = o0.rightCols(rest);
+  dst.bias(0) = old.bias(0);
+  for (int l = 1; l < dst.num_layers(); ++l) {
+    dst.weight(l) = old.weight(l);
+    dst.bias(l) = old.bias(l);
+  }
+}
+
+}  // namespace
+
+void warm_start_from_checkpoint(const std::string& path, Ddpg& ddpg) {
+  const std::vector<uint8_t> bytes = read_all(path);
+  const wire::Checkpoint* ck = verified(bytes, path);
+  const int obs = ck->obs_dim();
+  const int extra = ddpg.obs_dim() - obs;
+  const std::vector<int> actor_from = widths_of(ck->actor_widths());
+  const std::vector<int> critic_from = widths_of(ck->critic_widths());
+  std::vector<int> actor_to = actor_from;
+  std::vector<int> critic_to = critic_from;
+  if (!actor_to.empty() && !critic_to.empty()) {
+    actor_to.front() += extra;
+    critic_to.front() += extra;
+  }
+  if (extra < 0 || ck->action_dim() != ddpg.output_width() || actor_to != ddpg.actor().widths() ||
+      critic_to != ddpg.critic().widths()) {
+    throw std::runtime_error(
+        "train.init_from: checkpoint '" + path + "' has networks " + join_widths(actor_from) + " / " +
+        join_widths(critic_from) + " for " + std::to_string(obs) + " observations; this run's are " +
+        join_widths(ddpg.actor().widths()) + " / " + join_widths(ddpg.critic().widths()) + " for " +
+        std::to_string(ddpg.obs_dim()) +
+        ". A warm start needs the same ddpg.hidden and actions and at least the checkpoint's observations "
+        "(set ddpg.hidden to the checkpoint's, or leave train.init_from empty)");
+  }
+  widen_into(ck->actor(), actor_from, obs, extra, ddpg.actor(), "actor", path);
+  widen_into(ck->critic(), critic_from, obs, extra, ddpg.critic(), "critic", path);
+  widen_into(ck->target_actor(), actor_from, obs, extra, ddpg.target_actor(), "target_actor", path);
+  widen_into(ck->target_critic(), critic_from, obs, extra, ddpg.target_critic(), "target_critic", path);
+}
+
 std::string read_checkpoint_config(const std::string& path) {
   const std::vector<uint8_t> bytes = read_all(path);
   const wire::Checkpoint* ck = verified(bytes, path);

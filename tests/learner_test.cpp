@@ -337,6 +337,61 @@ TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
   fs::remove_all(dir);
 }
 
+// A warm start into a run with more observations: the checkpoint's first features map one to one,
+// the extra ones get zero weights, so every network computes what the checkpoint's did whatever
+// the extra features hold (actor: state; critic: state, then the action after it). Equal up to
+// float rounding: the GEMM sums a longer row in another order.
+TEST(Checkpoint, WarmStartWidensTheInputsExactly) {
+  const fs::path dir = fresh_dir("warm");
+  fs::create_directories(dir);
+  const std::string path = (dir / "w.ckpt").string();
+  toy::ReachStopEnv env;
+  const ActionSpace& space = env.action_space();
+  Ddpg from(3, space, tiny_config(), 1);
+  Rng rng(5);
+  for (Mlp<float>* net : {&from.actor(), &from.critic(), &from.target_actor(), &from.target_critic()}) {
+    net->init_gaussian(rng, 0.5F);  // targets differ from the online networks
+  }
+  save_checkpoint(path, from, {});
+  Ddpg to(5, space, tiny_config(), 2);
+  warm_start_from_checkpoint(path, to);
+
+  const int act = from.output_width();
+  Eigen::MatrixXf wide = Eigen::MatrixXf::Random(5 + act, 4);
+  Eigen::MatrixXf narrow(3 + act, 4);
+  narrow << wide.topRows(3), wide.bottomRows(act);
+  const std::pair<Mlp<float>*, Mlp<float>*> pairs[] = {{&from.actor(), &to.actor()},
+                                                       {&from.target_actor(), &to.target_actor()}};
+  for (const auto& [a, b] : pairs) {
+    const Eigen::MatrixXf expected = a->forward(narrow.topRows(3));
+    EXPECT_TRUE(Eigen::MatrixXf(b->forward(wide.topRows(5))).isApprox(expected, 1e-6F));
+  }
+  const std::pair<Mlp<float>*, Mlp<float>*> critics[] = {{&from.critic(), &to.critic()},
+                                                         {&from.target_critic(), &to.target_critic()}};
+  for (const auto& [a, b] : critics) {
+    const Eigen::MatrixXf expected = a->forward(narrow);
+    EXPECT_TRUE(Eigen::MatrixXf(b->forward(wide)).isApprox(expected, 1e-6F));
+  }
+  EXPECT_NE(Eigen::MatrixXf(to.actor().forward(wide.topRows(5))),
+            Eigen::MatrixXf(to.target_actor().forward(wide.topRows(5))));
+  EXPECT_EQ(to.updates(), 0);
+
+  // Other hidden widths, or fewer observations than the checkpoint's, are refused with the reason.
+  DdpgConfig wider = tiny_config();
+  wider.hidden = {9};
+  Ddpg other(5, space, wider, 1);
+  Ddpg fewer(2, space, tiny_config(), 1);
+  for (Ddpg* d : {&other, &fewer}) {
+    try {
+      warm_start_from_checkpoint(path, *d);
+      FAIL() << "a warm start into other shapes was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("train.init_from"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Config, DefaultsRoundTripAndOverrides) {
   const app::ExperimentConfig def = app::parse_experiment_config("", "empty", {});
   EXPECT_EQ(def.ddpg.hidden, (std::vector<int>{1024, 512, 256, 128}));
