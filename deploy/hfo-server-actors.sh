@@ -42,6 +42,7 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ -n $hfo_root ]] || die "--hfo-root is required (the HFO build: bin/HFO, bin/rcssserver)"
+hfo_root=$(cd "$hfo_root" 2>/dev/null && pwd) || die "--hfo-root: no such directory"
 [[ -x $hfo_root/bin/HFO && -x $hfo_root/bin/rcssserver ]] || die "no bin/HFO and bin/rcssserver in '$hfo_root' (run make install in HFO's build)"
 [[ -n $join ]] || die "--join is required (the learner's join endpoint, tcp://HOST:PORT)"
 [[ $actors =~ ^[0-9]+$ && $actors -ge 1 ]] || die "--actors must be a positive integer, got '$actors'"
@@ -59,6 +60,7 @@ for candidate in python3 /usr/bin/python3 python; do
 done
 [[ -n $py ]] || die "bin/HFO needs a Python with numpy (apt-get install python3-numpy)"
 mkdir -p "$log_dir"
+log_dir=$(cd "$log_dir" && pwd)  # servers run there: rcssserver writes its default configs into ./~/.rcssserver
 defense=()
 ((goalie == 0)) || defense=(--defense-npcs 1)
 
@@ -68,8 +70,8 @@ run_pair() {
   trap 'stopping=1; [[ -z $actor ]] || kill -TERM "$actor" 2>/dev/null; [[ -z $server ]] || kill -TERM -- "-$server" 2>/dev/null' TERM INT
   while ((stopping == 0)); do
     local log=$log_dir/hfo-$port.log
-    setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 "${defense[@]}" --headless --fullstate --no-logging \
-      --frames-per-trial 500 --port "$port" --seed $((seed + 100 * i + restart)) >"$log" 2>&1 &
+    (cd "$log_dir" && exec setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 "${defense[@]}" --headless \
+      --fullstate --no-logging --frames-per-trial 500 --port "$port" --seed $((seed + 100 * i + restart)) >"$log" 2>&1) &
     server=$!
     until grep -q "Waiting for player-controlled agent" "$log" 2>/dev/null; do
       kill -0 "$server" 2>/dev/null || { echo "hfo-server-actors: server on port $port exited; see $log" >&2; break; }

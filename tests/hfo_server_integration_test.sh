@@ -13,8 +13,9 @@
 set -euo pipefail
 bin=$1
 live=$2
-hfo_root=$3
+hfo_root=$(cd "$3" && pwd)
 work=$(mktemp -d)
+cd "$work"  # rcssserver writes its default configs into ./~/.rcssserver
 groups=()
 cleanup() {
   for g in "${groups[@]}"; do kill -TERM -- "-$g" 2>/dev/null || true; done
