@@ -31,6 +31,16 @@ DdpgConfig small() {
   return c;
 }
 
+// A learner on loopback ports chosen by the OS, for the toy task, that never times peers out.
+LearnerServerConfig loopback_config() {
+  LearnerServerConfig c;
+  c.join_bind = "tcp://127.0.0.1:*";
+  c.weights_bind = "tcp://127.0.0.1:*";
+  c.config_toml = "[env]\nname = \"reach_stop\"\n";
+  c.peer_timeout_ms = 60000;
+  return c;
+}
+
 struct Running {
   net::Context ctx;
   toy::ReachStopEnv env;
@@ -40,13 +50,9 @@ struct Running {
   std::thread thread;
   std::atomic<bool> done{false};
   Running() {
-    LearnerServerConfig c;
-    c.join_bind = "tcp://127.0.0.1:*";
-    c.weights_bind = "tcp://127.0.0.1:*";
-    c.config_toml = "[env]\nname = \"reach_stop\"\n";
+    LearnerServerConfig c = loopback_config();
     c.publish_every_updates = 5;
     c.max_updates = 20;
-    c.peer_timeout_ms = 60000;
     server = std::make_unique<LearnerServer>(ctx, backend, c);
     thread = std::thread([this] {
       server->run();  // returns by itself after max_updates
@@ -174,11 +180,7 @@ TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   toy::ReachStopEnv env;
   Ddpg ddpg{kObs, env.action_space(), small(), 1};
   CpuUpdateBackend backend{ddpg};
-  LearnerServerConfig c;
-  c.join_bind = "tcp://127.0.0.1:*";
-  c.weights_bind = "tcp://127.0.0.1:*";
-  c.config_toml = "[env]\nname = \"reach_stop\"\n";
-  c.peer_timeout_ms = 60000;
+  LearnerServerConfig c = loopback_config();
   c.metrics_url = "http://learner:1/metrics";
   LearnerServer server(ctx, backend, c);
   std::mutex mutex;
@@ -245,13 +247,9 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   toy::ReachStopEnv env;
   Ddpg ddpg{kObs, env.action_space(), small(), 1};
   CpuUpdateBackend backend{ddpg};
-  LearnerServerConfig c;
-  c.join_bind = "tcp://127.0.0.1:*";
-  c.weights_bind = "tcp://127.0.0.1:*";
-  c.config_toml = "[env]\nname = \"reach_stop\"\n";
+  LearnerServerConfig c = loopback_config();
   c.publish_every_updates = 2;
   c.max_updates = 400;
-  c.peer_timeout_ms = 60000;
   c.curve = server_keys;
   c.curve_client = good;
   LearnerServer server(ctx, backend, c);
