@@ -1,6 +1,10 @@
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,7 +32,51 @@ struct EvalOptions {
   std::string checkpoint;
   std::string env;                // overrides env.name
   std::vector<std::string> sets;  // env.* overrides
+  std::string trace;              // CSV of every step, when set
   SimOptions sim;
+};
+
+// `--trace FILE`: one CSV row per step with the observation the policy read, the action and
+// parameters it chose, and the env's reward and status, so that a user can see what a policy
+// does (how often it kicks, from where it shoots) without a debugger.
+class TraceCsv {
+ public:
+  TraceCsv(const std::string& path, const Env& env) : file_(std::fopen(path.c_str(), "w")), env_(env) {
+    if (file_ == nullptr) {
+      throw std::runtime_error("--trace " + path + ": cannot create the file (" + std::strerror(errno) +
+                               "); give a path in a writable directory");
+    }
+    std::fprintf(file_, "episode,step,action");
+    for (const ParamSpec& p : env.action_space().params) {
+      std::fprintf(file_, ",%s", p.name.c_str());
+    }
+    std::fprintf(file_, ",reward,status");
+    for (int i = 0; i < env.observation_size(); ++i) {
+      std::fprintf(file_, ",obs_%d", i);
+    }
+    std::fprintf(file_, "\n");
+  }
+  TraceCsv(const TraceCsv&) = delete;
+  TraceCsv& operator=(const TraceCsv&) = delete;
+  ~TraceCsv() { std::fclose(file_); }
+
+  void write(const EvalStep& s) {
+    const std::string& action = env_.action_space().actions[static_cast<size_t>(s.action.id)].name;
+    std::fprintf(file_, "%d,%d,%s", s.episode, s.step, action.c_str());
+    for (float p : s.action.params) {
+      std::fprintf(file_, ",%.6g", p);
+    }
+    const std::string_view status = env_.status_name(s.result.status);
+    std::fprintf(file_, ",%.6g,%.*s", s.result.reward, static_cast<int>(status.size()), status.data());
+    for (float x : s.obs) {
+      std::fprintf(file_, ",%.6g", x);
+    }
+    std::fprintf(file_, "\n");
+  }
+
+ private:
+  std::FILE* file_;
+  const Env& env_;
 };
 
 void print_result(const std::string& name, const EvalResult& r, bool json) {
@@ -51,8 +99,15 @@ void print_result(const std::string& name, const EvalResult& r, bool json) {
 // the pace on stderr (stdout stays the same for the same seed).
 EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, const EvalOptions& o) {
   ProgressBar bar("episodes", o.episodes);
+  std::optional<TraceCsv> trace;
+  std::function<void(const EvalStep&)> on_step;
+  if (!o.trace.empty()) {
+    trace.emplace(o.trace, *env);
+    on_step = [&trace](const EvalStep& s) { trace->write(s); };
+  }
   const auto start = std::chrono::steady_clock::now();
-  EvalResult r = evaluate(*env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); });
+  EvalResult r = evaluate(
+      *env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); }, on_step);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   bar.finish();
   const std::string env_name(env->name());
@@ -185,6 +240,9 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"hfo", "hfo-server", "reach_stop"}));
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
+  cmd->add_option("--trace", opts->trace,
+                  "write every step to this CSV file: episode, step, action, its parameters, reward, status and "
+                  "the observation the policy read");
   opts->sim.add_to(*cmd);
   cmd->callback([opts, cmd] { run_eval(*opts, *cmd); });
 }

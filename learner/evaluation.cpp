@@ -1,5 +1,6 @@
 #include "learner/evaluation.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -7,8 +8,10 @@
 
 namespace pamdp {
 
-EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const std::function<void(int)>& on_episode) {
+EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const std::function<void(int)>& on_episode,
+                    const std::function<void(const EvalStep&)>& on_step) {
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
+  std::vector<float> seen(on_step ? obs.size() : 0);  // the observation the policy acted on
   std::vector<int> counts(8, 0);
   EvalResult res;
   res.episodes = episodes;
@@ -26,9 +29,16 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const
     int steps = 0;
     StepResult sr;
     do {
-      sr = env.step(policy.act(obs), obs);
+      const ParamAction action = policy.act(obs);
+      if (on_step) {
+        std::copy(obs.begin(), obs.end(), seen.begin());
+      }
+      sr = env.step(action, obs);
       total_return += sr.reward;
       ++steps;
+      if (on_step) {
+        on_step(EvalStep{ep, steps, seen, action, sr});
+      }
     } while (!sr.terminal() && steps <= env.max_episode_steps());
     if (!sr.terminal()) {
       throw std::runtime_error("evaluate: env '" + std::string(env.name()) + "' ran past its max_episode_steps()");

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <span>
 #include <string>
 
 #include "core/policy.hpp"
@@ -22,10 +23,22 @@ struct EvalResult {
   std::map<std::string, int> outcomes;  // status name -> count (every outcome listed)
 };
 
+// One decision of an evaluation, as `on_step` sees it: the observation the policy read, the
+// action it chose and what the env answered. Views are valid only during the call.
+struct EvalStep {
+  int episode = 0;  // 0-based
+  int step = 0;     // 1-based within the episode
+  std::span<const float> obs;
+  ParamAction action;
+  StepResult result;
+};
+
 // Plays `episodes` episodes; the first reset uses `seed`, later ones continue the env's stream.
-// `on_episode`, when given, is called with the number of episodes done after each one.
+// `on_episode`, when given, is called with the number of episodes done after each one;
+// `on_step`, when given, after every step (the results do not depend on either).
 EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed,
-                    const std::function<void(int)>& on_episode = {});
+                    const std::function<void(int)>& on_episode = {},
+                    const std::function<void(const EvalStep&)>& on_step = {});
 
 // One JSON object (no newline) with keys episodes, goal_rate, avg_steps_to_goal, avg_return,
 // avg_steps, outcomes.

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -127,6 +128,52 @@ TEST(Cli, EvalJsonLastLineHasEveryKey) {
   const double rate = j.at("goal_rate").get<double>();
   EXPECT_GE(rate, 0.0);
   EXPECT_LE(rate, 1.0);
+}
+
+// --trace writes one CSV row per step (plus a header naming every column) and leaves the
+// table and the JSON as they are without it.
+TEST(Cli, EvalTraceWritesOneRowPerStep) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pamdp_trace_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "trace.csv").string();
+  const RunResult traced = run_pamdp("eval --episodes 4 --seed 3 --json --trace " + file, Capture::kStdoutOnly);
+  const RunResult plain = run_pamdp("eval --episodes 4 --seed 3 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(traced.exit_code, 0) << traced.output;
+  EXPECT_EQ(traced.output, plain.output);
+  std::vector<std::string> lines = split(traced.output, '\n');
+  while (!lines.empty() && lines.back().empty()) {
+    lines.pop_back();
+  }
+  ASSERT_FALSE(lines.empty());
+  const nlohmann::json j = nlohmann::json::parse(lines.back());
+
+  std::ifstream in(file);
+  std::string header;
+  ASSERT_TRUE(std::getline(in, header)) << file;
+  const std::vector<std::string> columns = split(header, ',');
+  ASSERT_GE(columns.size(), 3U + 6U + 2U + 58U) << header;
+  EXPECT_EQ(columns[0], "episode");
+  EXPECT_EQ(columns[2], "action");
+  EXPECT_EQ(columns.back(), "obs_57");
+  int rows = 0;
+  int goals = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> cells = split(line, ',');
+    ASSERT_EQ(cells.size(), columns.size()) << line;
+    ++rows;
+    goals += cells[columns.size() - 59] == "GOAL" ? 1 : 0;
+  }
+  EXPECT_EQ(rows, static_cast<int>(std::lround(j.at("avg_steps").get<double>() * 4)));
+  EXPECT_EQ(goals, j.at("outcomes").at("GOAL").get<int>());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, EvalTraceRefusesAnUnwritablePath) {
+  const RunResult r = run_pamdp("eval --episodes 1 --trace /nonexistent-dir/trace.csv");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--trace /nonexistent-dir/trace.csv"), std::string::npos) << r.output;
 }
 
 TEST(Cli, EvalIsDeterministicForAGivenSeed) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
@@ -85,6 +86,68 @@ TEST(Evaluate, SameSeedGivesSameResult) {
   const EvalResult a = evaluate(env_a, policy_a, 30, 42);
   const EvalResult b = evaluate(env_b, policy_b, 30, 42);
   EXPECT_EQ(to_json(a), to_json(b));
+}
+
+// on_step sees every step exactly once, in order, and adds up to the result it does not change.
+TEST(Evaluate, OnStepSeesEveryStepAndChangesNothing) {
+  hfo::HfoEnv env_a;
+  hfo::HfoEnv env_b;
+  hfo::ScriptedOffense policy_a;
+  hfo::ScriptedOffense policy_b;
+  constexpr int kEpisodes = 12;
+  const EvalResult plain = evaluate(env_a, policy_a, kEpisodes, 42);
+
+  int64_t steps = 0;
+  double reward = 0.0;
+  int terminals = 0;
+  int expected_episode = 0;
+  int expected_step = 1;
+  std::map<std::string, int> outcomes;
+  const EvalResult watched = evaluate(env_b, policy_b, kEpisodes, 42, {}, [&](const EvalStep& s) {
+    EXPECT_EQ(s.episode, expected_episode);
+    EXPECT_EQ(s.step, expected_step);
+    EXPECT_EQ(static_cast<int>(s.obs.size()), env_b.observation_size());
+    EXPECT_GE(s.action.id, 0);
+    EXPECT_LT(s.action.id, env_b.action_space().num_actions());
+    ++steps;
+    reward += s.result.reward;
+    if (s.result.terminal()) {
+      ++terminals;
+      ++outcomes[std::string(env_b.status_name(s.result.status))];
+      ++expected_episode;
+      expected_step = 1;
+    } else {
+      ++expected_step;
+    }
+  });
+  EXPECT_EQ(to_json(watched), to_json(plain));
+  EXPECT_EQ(terminals, kEpisodes);
+  EXPECT_DOUBLE_EQ(static_cast<double>(steps), plain.avg_steps * kEpisodes);
+  EXPECT_NEAR(reward, plain.avg_return * kEpisodes, 1e-6 * kEpisodes);
+  for (const auto& [name, count] : outcomes) {
+    EXPECT_EQ(plain.outcomes.at(name), count) << name;
+  }
+}
+
+// The first observation an episode's policy reads is the reset's, not the previous episode's
+// last one: check it against a fresh env reset with the same seed.
+TEST(Evaluate, OnStepObservationIsTheOneThePolicyRead) {
+  hfo::HfoEnv env;
+  hfo::HfoEnv reference;
+  hfo::ScriptedOffense policy;
+  std::vector<float> first(static_cast<size_t>(env.observation_size()));
+  reference.reset(7, first);
+  bool checked = false;
+  evaluate(env, policy, 1, 7, {}, [&](const EvalStep& s) {
+    if (s.step == 1) {
+      ASSERT_EQ(s.obs.size(), first.size());
+      for (size_t i = 0; i < first.size(); ++i) {
+        EXPECT_EQ(s.obs[i], first[i]) << "feature " << i;
+      }
+      checked = true;
+    }
+  });
+  EXPECT_TRUE(checked);
 }
 
 // An oracle for ReachStop: move straight at the target, stop once within tolerance.
