@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -33,6 +34,7 @@ struct EvalOptions {
   std::string env;                // overrides env.name
   std::vector<std::string> sets;  // env.* overrides
   std::string trace;              // CSV of every step, when set
+  std::string actor = "online";   // which actor of a checkpoint plays: online or target
   SimOptions sim;
 };
 
@@ -177,6 +179,11 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
+  if (o.actor == "target") {
+    // The slowly moving (Polyak-averaged, tau) copy the critic's targets use.
+    const auto target = ddpg.target_actor().params();
+    std::copy(target.begin(), target.end(), ddpg.actor().params().begin());
+  }
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
   print_result("ddpg", evaluate_with_progress(std::move(env), policy, o), o.json);
 }
@@ -240,6 +247,10 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"hfo", "hfo-server", "reach_stop"}));
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
+  cmd->add_option("--actor", opts->actor,
+                  "with --checkpoint: play the online actor, or the target actor (its soft-updated average)")
+      ->check(CLI::IsMember({"online", "target"}))
+      ->capture_default_str();
   cmd->add_option("--trace", opts->trace,
                   "write every step to this CSV file: episode, step, action, its parameters, reward, status and "
                   "the observation the policy read");

@@ -170,6 +170,24 @@ TEST(Cli, EvalTraceWritesOneRowPerStep) {
   std::filesystem::remove_all(dir);
 }
 
+// --actor target plays the checkpoint's target actor: a different network from the online one
+// (so a different result on the same episodes), and still the trained agent (it scores).
+TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
+  const RunResult online = run_pamdp("eval --checkpoint " + model + " --episodes 30 --json", Capture::kStdoutOnly);
+  const RunResult target =
+      run_pamdp("eval --checkpoint " + model + " --episodes 30 --json --actor target", Capture::kStdoutOnly);
+  ASSERT_EQ(online.exit_code, 0) << online.output;
+  ASSERT_EQ(target.exit_code, 0) << target.output;
+  EXPECT_NE(online.output, target.output);
+  std::vector<std::string> lines = split(target.output, '\n');
+  while (!lines.empty() && lines.back().empty()) {
+    lines.pop_back();
+  }
+  ASSERT_FALSE(lines.empty());
+  EXPECT_GE(nlohmann::json::parse(lines.back()).at("goal_rate").get<double>(), 0.8) << target.output;
+}
+
 TEST(Cli, EvalTraceRefusesAnUnwritablePath) {
   const RunResult r = run_pamdp("eval --episodes 1 --trace /nonexistent-dir/trace.csv");
   EXPECT_NE(r.exit_code, 0) << r.output;
@@ -210,6 +228,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"ZeroEpisodes", "eval --episodes 0", {"--episodes", "0"}},
                       BadInvocation{"NonNumericEpisodes", "eval --episodes many", {"--episodes", "many"}},
                       BadInvocation{"UnknownPolicy", "eval --policy foo", {"--policy", "foo"}},
+                      BadInvocation{"UnknownActor", "eval --actor average", {"--actor", "average"}},
                       BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
                       BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
                       // CLI11 answers these two with "A subcommand is required", naming neither the
