@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# bench/seeds.sh end to end on the toy task: two seeds trained side by side, evaluated, one table
+# row each, and the verdict counts them (ReachStop is solved by every seed in ~1 s); a target no
+# agent can meet is counted as missed; a bad --seeds list is refused by name.
+#   seeds_test.sh PAMDP_BIN SOURCE_DIR
+set -euo pipefail
+bin=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+out=$(PAMDP_BIN=$bin bash "$src/bench/seeds.sh" --config "$src/deploy/configs/reach_stop.toml" --seeds 1,2 \
+  --episodes 200 --target-rate 0.9 --target-steps 100 --out "$work/a" 2>"$work/a.err") || fail "seeds.sh failed: $out $(cat "$work/a.err")"
+echo "$out"
+[[ $(grep -cE '^\| reach_stop \| [12] \|' <<<"$out") -eq 2 ]] || fail "expected one row per seed"
+grep -q '^2 of 2 seeds reached scoring >= 0.9 with <= 100 steps' <<<"$out" || fail "verdict should count both seeds"
+[[ -f $work/a/seed1/best.ckpt || -f $work/a/seed1/checkpoint.ckpt ]] || fail "no checkpoint in the seed's run directory"
+
+# The same runs (resumed, nothing left to train) against a target of under one step: none meets it.
+out=$(PAMDP_BIN=$bin bash "$src/bench/seeds.sh" --config "$src/deploy/configs/reach_stop.toml" --seeds 1,2 \
+  --episodes 200 --target-rate 0.9 --target-steps 0.5 --out "$work/a" 2>/dev/null) || fail "rerun failed: $out"
+grep -q '^0 of 2 seeds reached' <<<"$out" || fail "an unreachable target must be counted as missed: $out"
+
+if err=$(bash "$src/bench/seeds.sh" --seeds 1,x 2>&1); then
+  fail "--seeds 1,x accepted"
+fi
+grep -q -- "--seeds" <<<"$err" || fail "the error does not name --seeds: $err"
+echo "seeds_test: ok"
