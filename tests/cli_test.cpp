@@ -58,6 +58,15 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
+// The last non-empty line of a command's output (where --json puts its object); "" if none.
+std::string last_line(const std::string& output) {
+  std::vector<std::string> lines = split(output, '\n');
+  while (!lines.empty() && lines.back().empty()) {
+    lines.pop_back();
+  }
+  return lines.empty() ? std::string() : lines.back();
+}
+
 std::string read_text(const std::string& path) {
   std::ifstream in(path);
   EXPECT_TRUE(in.good()) << "cannot read " << path;
@@ -109,15 +118,12 @@ TEST(Cli, NoSubcommandFails) {
 TEST(Cli, EvalJsonLastLineHasEveryKey) {
   const RunResult r = run_pamdp("eval --episodes 20 --json", Capture::kStdoutOnly);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::vector<std::string> lines = split(r.output, '\n');
-  while (!lines.empty() && lines.back().empty()) {
-    lines.pop_back();
-  }
-  ASSERT_FALSE(lines.empty());
+  const std::string last = last_line(r.output);
+  ASSERT_FALSE(last.empty());
   nlohmann::json j;
-  ASSERT_NO_THROW(j = nlohmann::json::parse(lines.back())) << "last line is not JSON: " << lines.back();
+  ASSERT_NO_THROW(j = nlohmann::json::parse(last)) << "last line is not JSON: " << last;
   for (const char* key : {"episodes", "goal_rate", "avg_steps_to_goal", "avg_return", "avg_steps", "outcomes"}) {
-    EXPECT_TRUE(j.contains(key)) << key << " missing from " << lines.back();
+    EXPECT_TRUE(j.contains(key)) << key << " missing from " << last;
   }
   EXPECT_EQ(j.value("episodes", -1), 20);
   int total = 0;
@@ -141,12 +147,7 @@ TEST(Cli, EvalTraceWritesOneRowPerStep) {
   const RunResult plain = run_pamdp("eval --episodes 4 --seed 3 --json", Capture::kStdoutOnly);
   ASSERT_EQ(traced.exit_code, 0) << traced.output;
   EXPECT_EQ(traced.output, plain.output);
-  std::vector<std::string> lines = split(traced.output, '\n');
-  while (!lines.empty() && lines.back().empty()) {
-    lines.pop_back();
-  }
-  ASSERT_FALSE(lines.empty());
-  const nlohmann::json j = nlohmann::json::parse(lines.back());
+  const nlohmann::json j = nlohmann::json::parse(last_line(traced.output));
 
   std::ifstream in(file);
   std::string header;
@@ -180,12 +181,7 @@ TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
   ASSERT_EQ(online.exit_code, 0) << online.output;
   ASSERT_EQ(target.exit_code, 0) << target.output;
   EXPECT_NE(online.output, target.output);
-  std::vector<std::string> lines = split(target.output, '\n');
-  while (!lines.empty() && lines.back().empty()) {
-    lines.pop_back();
-  }
-  ASSERT_FALSE(lines.empty());
-  EXPECT_GE(nlohmann::json::parse(lines.back()).at("goal_rate").get<double>(), 0.8) << target.output;
+  EXPECT_GE(nlohmann::json::parse(last_line(target.output)).at("goal_rate").get<double>(), 0.8) << target.output;
 }
 
 TEST(Cli, EvalTraceRefusesAnUnwritablePath) {
