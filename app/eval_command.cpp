@@ -193,6 +193,9 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
     run_checkpoint_eval(o, cmd);
     return;
   }
+  if (cmd.count("--actor") > 0) {
+    throw std::runtime_error("--actor " + o.actor + " picks a network of a checkpoint: give --checkpoint FILE too");
+  }
   ExperimentConfig c;
   c.env.name = o.env.empty() ? "hfo" : o.env;
   c.env.hfo = o.sim.resolved();

@@ -225,6 +225,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"NonNumericEpisodes", "eval --episodes many", {"--episodes", "many"}},
                       BadInvocation{"UnknownPolicy", "eval --policy foo", {"--policy", "foo"}},
                       BadInvocation{"UnknownActor", "eval --actor average", {"--actor", "average"}},
+                      BadInvocation{"ActorWithoutCheckpoint", "eval --actor target", {"--actor", "--checkpoint"}},
                       BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
                       BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
                       // CLI11 answers these two with "A subcommand is required", naming neither the
