@@ -71,9 +71,15 @@ for i in "${!pids[@]}"; do
   fi
 done
 
-# Each log ends with reproduce.sh's header, separator, row and JSON; the JSON gives the verdict.
-printf '\n| config | seed | updates | episodes | wall-clock (h) | .90 reached (updates / h) | .96 reached | scoring (%s ep) | avg steps to goal |\n' "$episodes"
-printf '| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n'
+# Each log ends with reproduce.sh's header, separator, row and JSON: the table takes the header
+# and separator from the first log that has them, and the JSON gives the verdict.
+echo
+for seed in "${seed_list[@]}"; do
+  if header=$(grep -m 1 -A 1 '^| config |' "$out/seed$seed.log"); then
+    echo "$header"
+    break
+  fi
+done
 met=0
 ran=0
 for seed in "${seed_list[@]}"; do
