@@ -1,23 +1,27 @@
 // BM_DdpgUpdate/32 (/128, /1024): one full DDPG update of the paper's networks (58 -> 1024 ->
 // 512 -> 256 -> 128 -> 4+6 actor, 68 -> ... -> 1 critic) at batch 32 (128, 1024) with inverting
 // gradients, through the learner's own Ddpg class; items = updates. The GPU versions are in
-// bench_ddpg_cuda.cpp.
-// BM_GemmRoofline: Eigen float GEMM on this core, the roofline the update is measured against
-// (items = FLOP, so items_per_second reads as FLOP/s).
+// bench_ddpg_cuda.cpp. BM_DdpgUpdateFast/32: the same with fast.toml's widths (256-128-64).
+// BM_GemmRoofline: float GEMM on this core through core/gemm.hpp (OpenBLAS where it was found,
+// the label says), the roofline the update is measured against (items = FLOP, so
+// items_per_second reads as FLOP/s). BM_GemmEigen: Eigen's own product on the same shapes, for
+// comparison.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "bench/update_bench.hpp"
+#include "core/gemm.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/ddpg.hpp"
 
 namespace {
 
-void BM_DdpgUpdate(benchmark::State& state) {
+void update(benchmark::State& state, const std::vector<int>& hidden) {
   const int batch = static_cast<int>(state.range(0));
   pamdp::DdpgConfig cfg;
+  cfg.hidden = hidden;
   cfg.batch_size = batch;
   cfg.bound = pamdp::BoundMethod::kInverting;
   const pamdp::ActionSpace& space = pamdp::hfo::hfo_action_space();
@@ -30,11 +34,22 @@ void BM_DdpgUpdate(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
   pamdp::bench::report_update_flop(state, ddpg, batch);
+  state.SetLabel(pamdp::gemm_backend());
+}
+
+void BM_DdpgUpdate(benchmark::State& state) {
+  update(state, pamdp::DdpgConfig{}.hidden);
 }
 BENCHMARK(BM_DdpgUpdate)->Arg(32)->Arg(128)->Arg(1024)->Unit(benchmark::kMillisecond);
 
-// C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate of Eigen here.
-void BM_GemmRoofline(benchmark::State& state) {
+void BM_DdpgUpdateFast(benchmark::State& state) {
+  update(state, {256, 128, 64});
+}
+BENCHMARK(BM_DdpgUpdateFast)->Arg(32)->Unit(benchmark::kMillisecond);
+
+// C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate here, through the
+// update's own gemm() (eigen = false) or Eigen's product.
+void gemm_rate(benchmark::State& state, bool eigen) {
   const auto m = state.range(0);
   const auto k = state.range(1);
   const auto n = state.range(2);
@@ -42,15 +57,29 @@ void BM_GemmRoofline(benchmark::State& state) {
   const Eigen::MatrixXf B = Eigen::MatrixXf::Random(k, n);
   Eigen::MatrixXf C(m, n);
   for (auto _ : state) {
-    C.noalias() = A * B;
+    if (eigen) {
+      C.noalias() = A * B;
+    } else {
+      pamdp::gemm<float>(pamdp::Op::kNone, A, pamdp::Op::kNone, B, C, /*accumulate=*/false);
+    }
     benchmark::DoNotOptimize(C.data());
   }
   state.SetItemsProcessed(state.iterations() * 2 * m * k * n);
+  state.SetLabel(eigen ? "Eigen" : pamdp::gemm_backend());
+}
+
+void BM_GemmRoofline(benchmark::State& state) {
+  gemm_rate(state, false);
 }
 BENCHMARK(BM_GemmRoofline)
     ->Args({2048, 2048, 2048})
     ->Args({512, 1024, 32})
     ->Args({1024, 512, 32})
     ->Unit(benchmark::kMillisecond);
+
+void BM_GemmEigen(benchmark::State& state) {
+  gemm_rate(state, true);
+}
+BENCHMARK(BM_GemmEigen)->Args({2048, 2048, 2048})->Args({1024, 512, 32})->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "core/mlp.hpp"
 
+#include "core/gemm.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -150,13 +152,12 @@ typename Mlp<Scalar>::ConstBlock Mlp<Scalar>::forward(const Eigen::Ref<const Mat
   for (int l = 0; l < layers; ++l) {
     const bool hidden = l + 1 < layers;
     auto z = (hidden ? pre_[l] : act_[l + 1]).leftCols(batch);
-    // Starting from the bias and accumulating the product saves a pass over z: Eigen's
-    // kernels compute dst += W * a anyway, and `=` would first zero dst.
+    // Starting from the bias and accumulating the product saves a pass over z.
     z.colwise() = bias(l);
     if (batch == 1) {
       gemv_accumulate(params_.data() + offsets_[l], widths_[l + 1], widths_[l], act_[l].data(), z.data());
     } else {
-      z.noalias() += weight(l) * act_[l].leftCols(batch);
+      gemm<Scalar>(Op::kNone, weight(l), Op::kNone, act_[l].leftCols(batch), z, /*accumulate=*/true);
     }
     if (hidden) {
       act_[l + 1].leftCols(batch) = z.cwiseMax(slope_ * z);
@@ -193,7 +194,7 @@ void Mlp<Scalar>::backprop(const Eigen::Ref<const Matrix>& d_output, bool want_p
       const int64_t weights = static_cast<int64_t>(widths_[l + 1]) * widths_[l];
       MatrixMap dw(grads_.data() + offsets_[l], widths_[l + 1], widths_[l]);
       Eigen::Map<Eigen::Matrix<Scalar, Eigen::Dynamic, 1>> db(grads_.data() + offsets_[l] + weights, widths_[l + 1]);
-      dw.noalias() = dz * act_[l].leftCols(batch).transpose();
+      gemm<Scalar>(Op::kNone, dz, Op::kTranspose, act_[l].leftCols(batch), dw, /*accumulate=*/false);
       // Row sums of dz, a column at a time: contiguous, vectorized adds.
       db = dz.col(0);
       for (Eigen::Index c = 1; c < batch; ++c) {
@@ -202,7 +203,7 @@ void Mlp<Scalar>::backprop(const Eigen::Ref<const Matrix>& d_output, bool want_p
     }
     if (l > 0) {
       auto d_prev = delta_[l - 1].leftCols(batch);
-      d_prev.noalias() = weight(l).transpose() * dz;
+      gemm<Scalar>(Op::kTranspose, weight(l), Op::kNone, dz, d_prev, /*accumulate=*/false);
       // Through layer l-1's leaky ReLU: the gradient passes where z > 0 and is scaled by the
       // slope elsewhere. Written as a multiply by max(slope, [z > 0]) (equal for slopes in
       // [0, 1]) over the contiguous block because GCC vectorizes that, but neither a ternary
@@ -216,7 +217,7 @@ void Mlp<Scalar>::backprop(const Eigen::Ref<const Matrix>& d_output, bool want_p
         d[i] *= std::max(slope, static_cast<Scalar>(z[i] > Scalar(0)));
       }
     } else if (want_input_grad) {
-      input_grad_.leftCols(batch).noalias() = weight(0).transpose() * dz;
+      gemm<Scalar>(Op::kTranspose, weight(0), Op::kNone, dz, input_grad_.leftCols(batch), /*accumulate=*/false);
     }
   }
 }

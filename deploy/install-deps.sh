@@ -5,7 +5,8 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev            # the MLP and its GEMMs
+  libeigen3-dev            # the MLP
+  libopenblas-dev          # the MLP's matrix products (core/gemm.hpp)
   libzmq3-dev cppzmq-dev   # transport between actors, replay shards and the learner
   libflatbuffers-dev flatbuffers-compiler  # wire and checkpoint format (flatc at build time)
   libspdlog-dev libfmt-dev # structured logs

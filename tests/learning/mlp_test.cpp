@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
+#include "core/gemm.hpp"
 #include "core/mlp.hpp"
 #include "core/optim.hpp"
 #include "core/rng.hpp"
@@ -506,6 +509,68 @@ TEST(Optim, SoftUpdate) {
   for (size_t i = 0; i < before.size(); ++i) {
     EXPECT_DOUBLE_EQ(target_net.params()[i], 1e-3 * online.params()[i] + (1 - 1e-3) * before[i]);
   }
+}
+
+// gemm against a plain triple loop in double, for every transpose combination, written and
+// accumulated, on blocks of larger matrices (leading dimension > rows), including a one-row
+// operand, a batch of one and a shape large enough for any library's blocked kernels.
+template <typename Scalar>
+void check_gemm(Op op_a, Op op_b, int m, int n, int k, bool accumulate) {
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  Rng rng(static_cast<uint64_t>(m * 131 + n * 17 + k));
+  auto random = [&](int rows, int cols) {
+    Matrix x(rows, cols);
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      x.data()[i] = static_cast<Scalar>(rng.uniform(-1.0, 1.0));
+    }
+    return x;
+  };
+  const bool ta = op_a == Op::kTranspose;
+  const bool tb = op_b == Op::kTranspose;
+  const Matrix a_store = random((ta ? k : m) + 3, ta ? m : k);
+  const Matrix b_store = random((tb ? n : k) + 2, tb ? k : n);
+  Matrix c_store = random(m + 5, n);
+  const Matrix c_before = c_store;
+  const auto a = a_store.topRows(ta ? k : m);
+  const auto b = b_store.topRows(tb ? n : k);
+  gemm<Scalar>(op_a, a, op_b, b, c_store.topRows(m), accumulate);
+  double worst = 0.0;
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < n; ++j) {
+      double want = accumulate ? static_cast<double>(c_before(i, j)) : 0.0;
+      for (int p = 0; p < k; ++p) {
+        want += static_cast<double>(ta ? a(p, i) : a(i, p)) * static_cast<double>(tb ? b(j, p) : b(p, j));
+      }
+      worst = std::max(worst, std::abs(static_cast<double>(c_store(i, j)) - want));
+    }
+  }
+  // Float sums of up to 300 products of magnitude <= 1: rounding well under 1e-4.
+  const double tolerance = std::is_same_v<Scalar, float> ? 1e-4 : 1e-12;
+  EXPECT_LT(worst, tolerance) << "op_a " << ta << " op_b " << tb << " " << m << "x" << n << "x" << k << " accumulate "
+                              << accumulate;
+  // Rows below the block are untouched.
+  EXPECT_TRUE((c_store.bottomRows(5).array() == c_before.bottomRows(5).array()).all());
+}
+
+TEST(Gemm, AgreesWithALoopForEveryTransposeOnBlocks) {
+  for (const Op op_a : {Op::kNone, Op::kTranspose}) {
+    for (const Op op_b : {Op::kNone, Op::kTranspose}) {
+      for (const bool accumulate : {false, true}) {
+        check_gemm<float>(op_a, op_b, 70, 32, 300, accumulate);
+        check_gemm<float>(op_a, op_b, 1, 32, 64, accumulate);
+        check_gemm<float>(op_a, op_b, 10, 1, 5, accumulate);
+        check_gemm<double>(op_a, op_b, 33, 7, 129, accumulate);
+      }
+    }
+  }
+  EXPECT_FALSE(gemm_backend().empty());
+}
+
+TEST(GemmDeathTest, ShapesThatDoNotAgreeAbort) {
+  const Eigen::MatrixXf a = Eigen::MatrixXf::Ones(3, 4);
+  const Eigen::MatrixXf b = Eigen::MatrixXf::Ones(5, 2);
+  Eigen::MatrixXf c(3, 2);
+  EXPECT_DEATH(gemm<float>(Op::kNone, a, Op::kNone, b, c, false), "shapes do not agree");
 }
 
 }  // namespace
