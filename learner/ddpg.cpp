@@ -1,5 +1,6 @@
 #include "learner/ddpg.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <stdexcept>
 
@@ -73,8 +74,20 @@ void Ddpg::act(std::span<const float> obs, std::span<float> out) {
   }
 }
 
+void Ddpg::schedule_learning_rates() {
+  if (config_.lr_decay_updates <= 0) {
+    return;
+  }
+  const double done =
+      std::min(1.0, static_cast<double>(updates_) / static_cast<double>(config_.lr_decay_updates));
+  const double scale = 1.0 - (1.0 - config_.lr_final_fraction) * done;
+  actor_adam_.set_learning_rate(config_.actor_learning_rate * scale);
+  critic_adam_.set_learning_rate(config_.critic_learning_rate * scale);
+}
+
 UpdateStats Ddpg::update(const BatchView& batch) {
   const int B = static_cast<int>(batch.states.cols());
+  schedule_learning_rates();
   assert(B <= config_.batch_size && batch.states.rows() == obs_dim_);
   const int W = output_width();
   UpdateStats stats;

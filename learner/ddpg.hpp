@@ -38,6 +38,10 @@ struct DdpgConfig {
   double clip_grad_norm = 10.0;  // global L2 norm per network; <= 0 disables
   BoundMethod bound = BoundMethod::kInverting;
   double mc_mix = 0.0;  // beta: y = beta * MC return + (1 - beta) * TD target
+  // Both learning rates fall linearly from their value to lr_final_fraction of it over the
+  // first lr_decay_updates updates, then stay there; 0 keeps them constant (the paper).
+  int64_t lr_decay_updates = 0;
+  double lr_final_fraction = 0.1;
   double init_std = 0.01;
   double critic_output_init_std = 0.05;  // the paper-era code's critic output layer
   double critic_output_init_bias = 1.0;
@@ -78,6 +82,9 @@ class Ddpg {
 
   UpdateStats update(const BatchView& batch);
   [[nodiscard]] int64_t updates() const { return updates_; }
+  // Sets both optimizers' learning rates for the next update from the decay schedule and
+  // updates(); update() calls it, and so does any other backend before each step.
+  void schedule_learning_rates();
   void set_updates(int64_t n) { updates_ = n; }
 
   [[nodiscard]] const DdpgConfig& config() const { return config_; }

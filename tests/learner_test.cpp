@@ -225,6 +225,32 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   EXPECT_EQ(d.updates(), 1);
 }
 
+TEST(Ddpg, LearningRatesDecayLinearlyThenHold) {
+  // lr 1e-3 (critic 2e-3) falls to 10 % over 4 updates: the update after k done uses
+  // lr * (1 - 0.9 * min(k / 4, 1)).
+  toy::ReachStopEnv env;
+  DdpgConfig c = tiny_config();
+  c.actor_learning_rate = 1e-3;
+  c.critic_learning_rate = 2e-3;
+  c.lr_decay_updates = 4;
+  c.lr_final_fraction = 0.1;
+  Ddpg d(3, env.action_space(), c, 5);
+  BatchBuffers b(3, 3, 4);
+  const double want[] = {1.0, 0.775, 0.55, 0.325, 0.1, 0.1};
+  for (const double scale : want) {
+    d.update(view_of(b, 3, 3, 4));
+    EXPECT_DOUBLE_EQ(d.actor_optimizer().config().learning_rate, 1e-3 * scale) << "after " << d.updates();
+    EXPECT_DOUBLE_EQ(d.critic_optimizer().config().learning_rate, 2e-3 * scale) << "after " << d.updates();
+  }
+  // Without a schedule the rates never move.
+  c.lr_decay_updates = 0;
+  Ddpg constant(3, env.action_space(), c, 5);
+  for (int i = 0; i < 3; ++i) {
+    constant.update(view_of(b, 3, 3, 4));
+  }
+  EXPECT_EQ(constant.actor_optimizer().config().learning_rate, 1e-3);
+}
+
 TEST(Ddpg, CriticLearnsAFixedTarget) {
   // Terminal transitions with reward r: the critic must regress Q(s, a) onto r.
   toy::ReachStopEnv env;

@@ -130,6 +130,7 @@ class CudaUpdateBackend final : public UpdateBackend {
     }
     ++actor_steps_;
     ++critic_steps_;
+    ddpg_.schedule_learning_rates();
     const auto actor_step = static_cast<float>(adam_step_size(ddpg_.actor_optimizer().config(), actor_steps_));
     const auto critic_step = static_cast<float>(adam_step_size(ddpg_.critic_optimizer().config(), critic_steps_));
     const cuda::HostBatch b{batch.states.data(),      batch.actions.data(),  batch.rewards.data(),
