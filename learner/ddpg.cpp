@@ -78,8 +78,7 @@ void Ddpg::schedule_learning_rates() {
   if (config_.lr_decay_updates <= 0) {
     return;
   }
-  const double done =
-      std::min(1.0, static_cast<double>(updates_) / static_cast<double>(config_.lr_decay_updates));
+  const double done = std::min(1.0, static_cast<double>(updates_) / static_cast<double>(config_.lr_decay_updates));
   const double scale = 1.0 - (1.0 - config_.lr_final_fraction) * done;
   actor_adam_.set_learning_rate(config_.actor_learning_rate * scale);
   critic_adam_.set_learning_rate(config_.critic_learning_rate * scale);
