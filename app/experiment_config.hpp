@@ -71,6 +71,9 @@ struct TrainLoopConfig {
   double updates_per_step = 1.0;
   int64_t eval_every_updates = 10000;  // 0 = never
   int eval_episodes = 10;
+  // > 0: an evaluation that would beat the best is confirmed on this many other episodes
+  // before best.ckpt is replaced (app/run_logs.hpp, BestEval); 0 = take it as it is.
+  int confirm_episodes = 0;
   double checkpoint_every_seconds = 600.0;
   double log_every_seconds = 10.0;
   // Warm start: a checkpoint whose networks a new run starts from (learner/checkpoint.hpp

@@ -7,6 +7,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -182,7 +183,24 @@ void run_learner(const LearnerCliOptions& o) {
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
       have_eval = true;
       learner_metrics.on_eval(last_eval);
-      if (best.offer(last_eval, ddpg.updates())) {
+      std::function<EvalResult()> confirm;
+      if (c.train.confirm_episodes > 0) {
+        confirm = [&] {
+          // Other starts than every screening evaluation's (seeds c.seed + updates).
+          return evaluate(*eval_env, policy, c.train.confirm_episodes,
+                          c.seed + static_cast<uint64_t>(ddpg.updates()) + (uint64_t{1} << 40));
+        };
+      }
+      EvalResult kept;
+      const bool better = best.offer(last_eval, ddpg.updates(), confirm, &kept);
+      if (confirm && kept.episodes > 0) {
+        log::info(
+            "learner: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on "
+            "{}: {}",
+            ddpg.updates(), last_eval.goal_rate, last_eval.episodes, kept.goal_rate, kept.avg_steps_to_goal,
+            kept.episodes, better ? "new best.ckpt" : "kept the old one");
+      }
+      if (better) {
         CheckpointMeta best_meta = meta;
         best_meta.elapsed_seconds = elapsed();
         best_meta.episodes = episode_count;

@@ -117,26 +117,39 @@ BestEval::BestEval(fs::path file) : file_(std::move(file)) {
   }
 }
 
-bool BestEval::offer(const EvalResult& r, int64_t updates) {
-  bool better = !best_;
-  if (best_) {
-    const EvalResult& b = *best_;
-    if (r.goal_rate != b.goal_rate) {
-      better = r.goal_rate > b.goal_rate;
-    } else if (r.goal_rate > 0.0 && r.avg_steps_to_goal != b.avg_steps_to_goal) {
-      better = r.avg_steps_to_goal < b.avg_steps_to_goal;
-    } else {
-      better = r.avg_return > b.avg_return;
-    }
+bool BestEval::beats_best(const EvalResult& r) const {
+  if (!best_) {
+    return true;
   }
-  if (!better) {
+  const EvalResult& b = *best_;
+  if (r.goal_rate != b.goal_rate) {
+    return r.goal_rate > b.goal_rate;
+  }
+  if (r.goal_rate > 0.0 && r.avg_steps_to_goal != b.avg_steps_to_goal) {
+    return r.avg_steps_to_goal < b.avg_steps_to_goal;
+  }
+  return r.avg_return > b.avg_return;
+}
+
+bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm,
+                     EvalResult* kept) {
+  if (!beats_best(r)) {
     return false;
   }
-  best_ = r;
+  const EvalResult result = confirm ? confirm() : r;
+  if (kept != nullptr) {
+    *kept = result;
+  }
+  if (confirm && !beats_best(result)) {
+    return false;
+  }
+  best_ = result;
   std::ostringstream text;
   text.precision(17);
-  text << r.goal_rate << ' ' << r.avg_steps_to_goal << ' ' << r.avg_return << ' ' << updates << '\n'
-       << "# success rate, avg steps to success, avg return, updates of the best greedy evaluation (best.ckpt)\n";
+  text << result.goal_rate << ' ' << result.avg_steps_to_goal << ' ' << result.avg_return << ' ' << updates << ' '
+       << result.episodes << '\n'
+       << "# success rate, avg steps to success, avg return, updates, episodes of the best greedy evaluation "
+          "(best.ckpt)\n";
   const std::string s = text.str();
   write_file_atomically(file_.string(), s.data(), s.size());
   return true;

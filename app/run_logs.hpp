@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -79,16 +80,26 @@ class RunLogs {
 // Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
 // success, then a higher return. Persisted in a small text file (the run directory's
 // best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.
+//
+// The maximum over a run's ~200 evaluations of 100 episodes is biased upwards: the policy that
+// scored 1.0 on one set of starts scores .93 on another. With `confirm`, an evaluation that
+// would beat the best is only a candidate: confirm() evaluates the same policy again (on more,
+// independent episodes) and that result is what is compared and kept, so the figure in
+// best_eval.txt is the candidate's unbiased score, not its lucky draw.
 class BestEval {
  public:
   explicit BestEval(std::filesystem::path file);
 
-  // True when `r` beats every evaluation offered before (the first one always does); then the
-  // file is rewritten (atomically) with `r` and `updates`.
-  bool offer(const EvalResult& r, int64_t updates);
+  // True when the (confirmed) result beats every one kept before (the first one always does);
+  // then the file is rewritten (atomically) with it and `updates`. `kept`, when given, receives
+  // the result that was compared (the confirmation's, when one ran).
+  bool offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm = {},
+             EvalResult* kept = nullptr);
   [[nodiscard]] const std::optional<EvalResult>& best() const { return best_; }
 
  private:
+  [[nodiscard]] bool beats_best(const EvalResult& r) const;
+
   std::filesystem::path file_;
   std::optional<EvalResult> best_;
 };

@@ -6,6 +6,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -215,7 +216,23 @@ void Trainer::run_eval() {
   if (o_.metrics != nullptr) {
     o_.metrics->on_eval(last_eval_);
   }
-  if (best_ && best_->offer(last_eval_, ddpg_.updates())) {
+  if (!best_) {
+    return;
+  }
+  std::function<EvalResult()> confirm;
+  if (c_.train.confirm_episodes > 0) {
+    confirm = [&] {
+      return evaluate(*eval_env_, policy, c_.train.confirm_episodes, mix(mix(c_.seed, 1000 + ddpg_.updates()), 1));
+    };
+  }
+  EvalResult kept;
+  const bool better = best_->offer(last_eval_, ddpg_.updates(), confirm, &kept);
+  if (confirm && kept.episodes > 0) {
+    log::info("train: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}: {}",
+              ddpg_.updates(), last_eval_.goal_rate, last_eval_.episodes, kept.goal_rate, kept.avg_steps_to_goal,
+              kept.episodes, better ? "new best.ckpt" : "kept the old one");
+  }
+  if (better) {
     save_best();
   }
 }

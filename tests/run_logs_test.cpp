@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -131,6 +132,45 @@ TEST(BestEval, RateThenStepsThenReturnAndItSurvivesARestart) {
   EXPECT_DOUBLE_EQ(resumed.best()->avg_steps_to_goal, 80.0);
   EXPECT_FALSE(resumed.offer(eval_of(0.7, 10.0, 9.0), 70));
   EXPECT_TRUE(resumed.offer(eval_of(0.9, 100.0, 0.0), 80));
+  fs::remove_all(dir);
+}
+
+TEST(BestEval, ACandidateIsJudgedByItsConfirmation) {
+  const fs::path dir = fresh_dir("best_confirm");
+  const fs::path file = dir / "best_eval.txt";
+  int confirmations = 0;
+  auto confirming = [&](double rate, double steps) {
+    return std::function<EvalResult()>([&confirmations, rate, steps] {
+      ++confirmations;
+      EvalResult r = eval_of(rate, steps, 0.0);
+      r.episodes = 1000;
+      return r;
+    });
+  };
+  {
+    BestEval best(file);
+    EvalResult kept;
+    // The first candidate is confirmed, and the confirmation is what is kept.
+    EXPECT_TRUE(best.offer(eval_of(1.0, 70.0, 0.0), 10, confirming(0.93, 75.0), &kept));
+    EXPECT_EQ(confirmations, 1);
+    EXPECT_DOUBLE_EQ(kept.goal_rate, 0.93);
+    EXPECT_DOUBLE_EQ(best.best()->goal_rate, 0.93);
+    // A screening result below the confirmed best is not confirmed at all.
+    EXPECT_FALSE(best.offer(eval_of(0.92, 60.0, 0.0), 20, confirming(0.99, 60.0), &kept));
+    EXPECT_EQ(confirmations, 1);
+    // A lucky screen whose confirmation is worse does not replace the best.
+    EXPECT_FALSE(best.offer(eval_of(0.97, 70.0, 0.0), 30, confirming(0.91, 70.0), &kept));
+    EXPECT_EQ(confirmations, 2);
+    EXPECT_DOUBLE_EQ(kept.goal_rate, 0.91);
+    EXPECT_DOUBLE_EQ(best.best()->goal_rate, 0.93);
+    // One whose confirmation is better does.
+    EXPECT_TRUE(best.offer(eval_of(0.95, 70.0, 0.0), 40, confirming(0.95, 72.0), &kept));
+    EXPECT_EQ(confirmations, 3);
+  }
+  BestEval resumed(file);
+  ASSERT_TRUE(resumed.best().has_value());
+  EXPECT_DOUBLE_EQ(resumed.best()->goal_rate, 0.95);
+  EXPECT_DOUBLE_EQ(resumed.best()->avg_steps_to_goal, 72.0);
   fs::remove_all(dir);
 }
 
