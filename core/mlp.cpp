@@ -1,7 +1,5 @@
 #include "core/mlp.hpp"
 
-#include "core/gemm.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "core/gemm.hpp"
 
 namespace pamdp {
 namespace {

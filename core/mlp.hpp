@@ -15,8 +15,9 @@
 //
 // Cost: forward ~ 2 * sum(in*out) * batch FLOP; backward ~ twice that. Buffers for up to
 // max_batch samples are allocated in the constructor; forward() and backward() allocate
-// nothing, but Eigen's product workspaces then live on the stack: up to ~1.5 MB at the paper's
-// widths (core/CMakeLists.txt), so run them on threads with default-sized (8 MiB) stacks.
+// nothing. Batched products go through core/gemm.hpp (OpenBLAS, or Eigen without it); on Eigen
+// their workspaces live on the stack: up to ~1.5 MB at the paper's widths (core/CMakeLists.txt),
+// so run them on threads with default-sized (8 MiB) stacks.
 // Not thread-safe: one Mlp per thread (copies are cheap to make for actors).
 #pragma once
 
