@@ -1,5 +1,7 @@
 #include "app/run_logs.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -24,19 +26,80 @@ std::string join(const std::vector<std::string>& columns) {
   return line;
 }
 
+// Rows whose integer in column `column` is at most `limit` (a resumed run's counters).
+struct KeepUpTo {
+  size_t column = 0;
+  int64_t limit = 0;
+};
+
+// The integer at the start of field `column` of a CSV row without quoting; nullopt when the row
+// is shorter or the field is not a number (a row cut off by a kill).
+std::optional<int64_t> field_as_integer(const std::string& row, size_t column) {
+  size_t begin = 0;
+  for (size_t i = 0; i < column; ++i) {
+    begin = row.find(',', begin);
+    if (begin == std::string::npos) {
+      return std::nullopt;
+    }
+    ++begin;
+  }
+  int64_t value = 0;
+  const char* first = row.data() + begin;
+  const char* last = row.data() + row.size();
+  const auto [end, ec] = std::from_chars(first, last, value);
+  if (ec != std::errc() || (end != last && *end != ',')) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+// Rewrites `path` (header first) without the rows past `keep`, and without a last row cut off
+// mid-line; returns how many rows were dropped.
+size_t drop_rows_past(const fs::path& path, const std::string& header, const KeepUpTo& keep) {
+  std::ifstream in(path);
+  std::string kept = header + '\n';
+  std::string row;
+  std::getline(in, row);  // the header, checked by the caller
+  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
+  const auto width = fields(header);
+  size_t dropped = 0;
+  while (std::getline(in, row)) {
+    const std::optional<int64_t> v = field_as_integer(row, keep.column);
+    if (v && *v <= keep.limit && fields(row) == width) {
+      kept += row;
+      kept += '\n';
+    } else {
+      ++dropped;
+    }
+  }
+  in.close();
+  if (dropped > 0) {
+    write_file_atomically(path.string(), kept.data(), kept.size());
+  }
+  return dropped;
+}
+
 // Opens `path` for appending with `header` as its first line. A file that exists with another
-// header (an older format) is moved aside rather than mixed with rows of this format.
-std::ofstream open_csv(const fs::path& path, const std::string& header) {
+// header (an older format) is moved aside rather than mixed with rows of this format; with
+// `keep`, the rows past it are dropped first.
+std::ofstream open_csv(const fs::path& path, const std::string& header, std::optional<KeepUpTo> keep) {
   bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
   if (!fresh) {
     std::ifstream in(path);
     std::string first;
     std::getline(in, first);
+    in.close();
     if (first != header) {
       const fs::path aside = path.string() + ".old-format";
       fs::rename(path, aside);
       log::warn("{} has another column layout; moved it to {} and started a new one", path.string(), aside.string());
       fresh = true;
+    } else if (keep) {
+      const size_t dropped = drop_rows_past(path, header, *keep);
+      if (dropped > 0) {
+        log::info("{}: dropped {} rows written after the checkpoint (the resumed run writes them again)", path.string(),
+                  dropped);
+      }
     }
   }
   std::ofstream out(path, std::ios::app);
@@ -69,12 +132,19 @@ const std::vector<std::string>& RunLogs::episode_columns() {
   return columns;
 }
 
-RunLogs::RunLogs(const fs::path& dir, std::vector<std::string> extra_metric_columns)
+RunLogs::RunLogs(const fs::path& dir, std::vector<std::string> extra_metric_columns,
+                 std::optional<ResumePoint> resume_at)
     : extras_(std::move(extra_metric_columns)) {
   std::vector<std::string> columns = metric_columns();
   columns.insert(columns.end(), extras_.begin(), extras_.end());
-  metrics_ = open_csv(dir / "metrics.csv", join(columns));
-  episodes_ = open_csv(dir / "episodes.csv", join(episode_columns()));
+  std::optional<KeepUpTo> metrics_keep;
+  std::optional<KeepUpTo> episodes_keep;
+  if (resume_at) {
+    metrics_keep = KeepUpTo{1, resume_at->updates};    // the "updates" column
+    episodes_keep = KeepUpTo{0, resume_at->episodes};  // the "episode" column
+  }
+  metrics_ = open_csv(dir / "metrics.csv", join(columns), metrics_keep);
+  episodes_ = open_csv(dir / "episodes.csv", join(episode_columns()), episodes_keep);
 }
 
 void RunLogs::metrics(const MetricsRow& r, std::span<const double> extras) {

@@ -12,6 +12,8 @@
 // "success" is the env's success outcome (GOAL in HFO). Eval columns are empty until the first
 // greedy evaluation. Files are appended to (a resumed run continues them); a file whose header
 // is not this format (a run from an older version) is renamed to NAME.old-format and restarted.
+// A resumed `pamdp train` run first drops the rows its killed predecessor wrote after the last
+// checkpoint: it replays that stretch bit for bit and writes those rows again.
 // Rows are flushed at every metrics row so a killed run keeps its log up to the last one.
 // Not thread-safe; cost: one formatted line per call.
 #pragma once
@@ -57,11 +59,19 @@ struct EpisodeRow {
   uint64_t weights_version = 0;
 };
 
+// Where a resumed run continues: its checkpoint's counters.
+struct ResumePoint {
+  int64_t updates = 0;
+  int64_t episodes = 0;
+};
+
 class RunLogs {
  public:
-  // Opens (appending) dir/metrics.csv and dir/episodes.csv. Throws std::runtime_error naming the
-  // file when one cannot be written.
-  RunLogs(const std::filesystem::path& dir, std::vector<std::string> extra_metric_columns = {});
+  // Opens (appending) dir/metrics.csv and dir/episodes.csv. With `resume_at`, metrics rows of
+  // more updates and episode rows of a later episode are removed first. Throws
+  // std::runtime_error naming the file when one cannot be written.
+  RunLogs(const std::filesystem::path& dir, std::vector<std::string> extra_metric_columns = {},
+          std::optional<ResumePoint> resume_at = std::nullopt);
 
   // `extras` has one value per extra column given to the constructor.
   void metrics(const MetricsRow& row, std::span<const double> extras = {});

@@ -314,7 +314,11 @@ TrainSummary Trainer::run() {
     const std::string text = to_toml(c_);
     write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
   }
-  logs_.emplace(dir);
+  std::optional<ResumePoint> resume_at;
+  if (o_.resume) {
+    resume_at = ResumePoint{static_cast<int64_t>(ddpg_.updates()), static_cast<int64_t>(episodes_)};
+  }
+  logs_.emplace(dir, std::vector<std::string>{}, resume_at);
   best_.emplace(dir / "best_eval.txt");
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);

@@ -87,6 +87,51 @@ TEST(RunLogs, WritesHeadersOnceAndRowsInColumnOrder) {
   fs::remove_all(dir);
 }
 
+// A killed `pamdp train` logged past its last checkpoint; the resumed run replays that stretch and
+// logs it again, so the rows after the checkpoint go (and so does a row cut off mid-line).
+TEST(RunLogs, AResumedRunDropsTheRowsWrittenAfterItsCheckpoint) {
+  const fs::path dir = fresh_dir("resume");
+  {
+    RunLogs logs(dir);
+    for (const int64_t updates : {100, 200, 300, 400}) {
+      MetricsRow row;
+      row.updates = updates;
+      row.episodes = updates / 10;
+      logs.metrics(row);
+    }
+    for (int64_t episode = 1; episode <= 5; ++episode) {
+      logs.episode(EpisodeRow{episode, 0.5, episode * 10, 0, 1.0, 20, "GOAL", 0});
+    }
+    logs.flush();
+  }
+  std::ofstream(dir / "episodes.csv", std::ios::app) << "3,0.5,3";  // a kill mid-row
+  {
+    RunLogs resumed(dir, {}, ResumePoint{250, 3});
+    MetricsRow row;
+    row.updates = 260;
+    resumed.metrics(row);
+    resumed.episode(EpisodeRow{4, 0.5, 40, 0, 1.0, 20, "GOAL", 0});
+    resumed.flush();
+  }
+  const auto m = lines_of(dir / "metrics.csv");
+  ASSERT_EQ(m.size(), 4U);  // header, 100, 200, then the resumed run's 260
+  EXPECT_EQ(m[1].substr(0, 6), "0,100,");
+  EXPECT_EQ(m[2].substr(0, 6), "0,200,");
+  EXPECT_EQ(m[3].substr(0, 6), "0,260,");
+  const auto e = lines_of(dir / "episodes.csv");
+  ASSERT_EQ(e.size(), 5U);  // header, episodes 1-3, the resumed run's 4
+  for (size_t i = 1; i < e.size(); ++i) {
+    EXPECT_EQ(e[i].substr(0, 2), std::to_string(i) + ",") << e[i];
+  }
+  EXPECT_EQ(e[4], "4,0.5,40,0,1,20,GOAL,0");
+
+  {
+    RunLogs plain(dir);  // without a resume point nothing is dropped
+  }
+  EXPECT_EQ(lines_of(dir / "metrics.csv").size(), 4U);
+  fs::remove_all(dir);
+}
+
 TEST(RunLogs, MovesAsideAFileOfAnotherLayout) {
   const fs::path dir = fresh_dir("aside");
   std::ofstream(dir / "metrics.csv") << "wall_seconds,updates,old_column\n1,2,3\n";
