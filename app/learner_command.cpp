@@ -123,7 +123,7 @@ void run_learner(const LearnerCliOptions& o) {
 
   RunLogs logs(run_dir, {"samples_per_s", "shards", "actors_joined", "weights_version", "malformed_messages",
                          "waiting_for_data_ms"});
-  BestEval best(fs::path(run_dir) / "best_eval.txt");
+  BestEval best(fs::path(run_dir) / "best_eval.txt", "learner");
 
   RecentEpisodes recent;
   UpdateStats last_stats;
@@ -191,16 +191,7 @@ void run_learner(const LearnerCliOptions& o) {
                           c.seed + static_cast<uint64_t>(ddpg.updates()) + (uint64_t{1} << 40));
         };
       }
-      EvalResult kept;
-      const bool better = best.offer(last_eval, ddpg.updates(), confirm, &kept);
-      if (confirm && kept.episodes > 0) {
-        log::info(
-            "learner: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on "
-            "{}: {}",
-            ddpg.updates(), last_eval.goal_rate, last_eval.episodes, kept.goal_rate, kept.avg_steps_to_goal,
-            kept.episodes, better ? "new best.ckpt" : "kept the old one");
-      }
-      if (better) {
+      if (best.offer(last_eval, ddpg.updates(), confirm)) {
         CheckpointMeta best_meta = meta;
         best_meta.elapsed_seconds = elapsed();
         best_meta.episodes = episode_count;

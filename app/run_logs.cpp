@@ -179,7 +179,7 @@ void RunLogs::flush() {
   episodes_.flush();
 }
 
-BestEval::BestEval(fs::path file) : file_(std::move(file)) {
+BestEval::BestEval(fs::path file, std::string role) : file_(std::move(file)), role_(std::move(role)) {
   std::ifstream in(file_);
   EvalResult r;
   if (in >> r.goal_rate >> r.avg_steps_to_goal >> r.avg_return) {
@@ -210,8 +210,14 @@ bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<E
   if (kept != nullptr) {
     *kept = result;
   }
-  if (confirm && !beats_best(result)) {
-    return false;
+  if (confirm) {
+    const bool better = beats_best(result);
+    log::info("{}: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}: {}",
+              role_, updates, r.goal_rate, r.episodes, result.goal_rate, result.avg_steps_to_goal, result.episodes,
+              better ? "new best.ckpt" : "kept the old one");
+    if (!better) {
+      return false;
+    }
   }
   best_ = result;
   std::ostringstream text;

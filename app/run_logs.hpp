@@ -98,11 +98,13 @@ class RunLogs {
 // best_eval.txt is the candidate's unbiased score, not its lucky draw.
 class BestEval {
  public:
-  explicit BestEval(std::filesystem::path file);
+  // `role` ("train", "learner") begins the log line of each confirmation.
+  explicit BestEval(std::filesystem::path file, std::string role = "train");
 
   // True when the (confirmed) result beats every one kept before (the first one always does);
   // then the file is rewritten (atomically) with it and `updates`. `kept`, when given, receives
-  // the result that was compared (the confirmation's, when one ran).
+  // the result that was compared (the confirmation's, when one ran). A confirmation is logged
+  // with both results and the verdict.
   bool offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm = {},
              EvalResult* kept = nullptr);
   [[nodiscard]] const std::optional<EvalResult>& best() const { return best_; }
@@ -111,6 +113,7 @@ class BestEval {
   [[nodiscard]] bool beats_best(const EvalResult& r) const;
 
   std::filesystem::path file_;
+  std::string role_;
   std::optional<EvalResult> best_;
 };
 

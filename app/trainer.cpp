@@ -225,14 +225,7 @@ void Trainer::run_eval() {
       return evaluate(*eval_env_, policy, c_.train.confirm_episodes, mix(mix(c_.seed, 1000 + ddpg_.updates()), 1));
     };
   }
-  EvalResult kept;
-  const bool better = best_->offer(last_eval_, ddpg_.updates(), confirm, &kept);
-  if (confirm && kept.episodes > 0) {
-    log::info("train: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}: {}",
-              ddpg_.updates(), last_eval_.goal_rate, last_eval_.episodes, kept.goal_rate, kept.avg_steps_to_goal,
-              kept.episodes, better ? "new best.ckpt" : "kept the old one");
-  }
-  if (better) {
+  if (best_->offer(last_eval_, ddpg_.updates(), confirm)) {
     save_best();
   }
 }
