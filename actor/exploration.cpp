@@ -15,6 +15,13 @@ double linear_epsilon(int64_t updates, double start, double end, int64_t anneal)
   return start + (end - start) * frac;
 }
 
+double demo_share(int64_t updates, double fraction, int64_t anneal) {
+  if (anneal <= 0) {
+    return fraction;
+  }
+  return linear_epsilon(updates, fraction, 0.0, anneal);
+}
+
 double apex_epsilon(int actor_index, int num_actors, double base, double alpha) {
   if (num_actors <= 1) {
     return base;

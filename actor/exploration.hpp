@@ -26,7 +26,17 @@ struct ExplorationConfig {
   // Sampling range of each parameter for random actions; empty = the action space's bounds.
   std::vector<float> random_param_lo;
   std::vector<float> random_param_hi;
+  // Demonstrations (pamdp train, HFO only): the share of episodes the scripted offense plays
+  // instead of the actor, falling linearly to 0 over demo_anneal_updates learner updates (0:
+  // constant). Their transitions go to replay like any other; the stored action is the scripted
+  // one (score 1 for its action, -1 for the others, its parameters; the parameters of the other
+  // actions are the actor's own output).
+  double demo_fraction = 0.0;
+  int64_t demo_anneal_updates = 0;
 };
+
+// The demonstration share after `updates` learner updates (see ExplorationConfig).
+double demo_share(int64_t updates, double fraction, int64_t anneal);
 
 // Linear from start to end over `anneal` learner updates, then constant.
 double linear_epsilon(int64_t updates, double start, double end, int64_t anneal);

@@ -71,6 +71,8 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("exploration.epsilon_anneal_updates", c.exploration.epsilon_anneal_updates, 0, INT64_MAX);
   v.str_list("exploration.masked_actions", c.masked_actions);
   v.ranges("exploration.random_param_ranges", c.random_param_ranges);
+  v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
+  v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
 
   v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
@@ -404,6 +406,14 @@ void validate(const ExperimentConfig& c, const std::string& src) {
   }
   if (c.replay.warmup < c.ddpg.batch_size) {
     throw std::runtime_error(src + ": replay.warmup must be at least ddpg.batch_size");
+  }
+  const bool embedded_features =
+      c.env.name == "hfo" || (c.env.name == "hfo-server" && c.env.server_encoding == hfo_server::Encoding::kEmbedded);
+  if (c.exploration.demo_fraction > 0.0 && !embedded_features) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
+                             "HFO features: use env.name = \"hfo\" (or hfo-server with env.server_encoding = "
+                             "\"embedded\"), or set exploration.demo_fraction = 0");
   }
 }
 

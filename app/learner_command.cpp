@@ -70,6 +70,12 @@ void run_learner(const LearnerCliOptions& o) {
       throw std::runtime_error("run directory '" + run_dir + "' already holds a run; use --resume " + run_dir);
     }
   }
+  if (c.exploration.demo_fraction > 0.0) {
+    throw std::runtime_error(
+        "exploration.demo_fraction = " + std::to_string(c.exploration.demo_fraction) +
+        ": demonstrations are played by pamdp train only, the cluster's actors do not play them; set "
+        "exploration.demo_fraction = 0 (--set exploration.demo_fraction=0) or train with pamdp train");
+  }
   fs::create_directories(run_dir);
   const std::string config_text = to_toml(c);
   if (!resume) {

@@ -7,7 +7,10 @@
 //                 eval_avg_return, then the role's extra columns (the learner's: samples/s,
 //                 shards, actors, weights version, bad messages, time waiting for data).
 //   episodes.csv  one row per episode: episode, wall_seconds, updates, actor, return, steps,
-//                 outcome, weights_version.
+//                 outcome, weights_version. weights_version 0: no network chose the actions (ε = 1
+//                 before the first weights or update, or a demonstration by the scripted offense,
+//                 exploration.demo_fraction); the training rates (success_rate_100, …) of
+//                 `pamdp train` leave demonstrations out.
 //
 // "success" is the env's success outcome (GOAL in HFO). Eval columns are empty until the first
 // greedy evaluation. Files are appended to (a resumed run continues them); a file whose header

@@ -20,6 +20,7 @@
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
+#include "envs/hfo/scripted_offense.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/update_backend.hpp"
@@ -115,6 +116,7 @@ class Trainer {
   void log_tick(bool force);
   void run_eval();
   void save_best();
+  int store_demo_action();
   [[nodiscard]] bool should_stop() const;
   [[nodiscard]] double elapsed() const {
     return base_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -136,6 +138,7 @@ class Trainer {
   std::unique_ptr<UpdateBackend> backend_;
   ReplayBuffer replay_;
   EpsilonGreedy explore_;
+  hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
   Rng sample_rng_;
   BatchBuffers batch_;
   EpisodeBuffer episode_;
@@ -293,6 +296,22 @@ void Trainer::log_tick(bool force) {
   }
 }
 
+// The scripted offense's action for obs_, written into stored_ as the actor's output vector would
+// carry it: score 1 for its action and -1 for the others, its parameters, and the actor's own
+// output (net_out_) for the parameters of the other actions. Returns the action id.
+int Trainer::store_demo_action() {
+  const ParamAction a = demo_.act(obs_);
+  const int num_actions = space_.num_actions();
+  std::copy(net_out_.begin(), net_out_.end(), stored_.begin());
+  for (int k = 0; k < num_actions; ++k) {
+    stored_[static_cast<size_t>(k)] = k == a.id ? 1.0F : -1.0F;
+  }
+  for (const int p : space_.actions[static_cast<size_t>(a.id)].param_indices) {
+    stored_[static_cast<size_t>(num_actions + p)] = a.params[static_cast<size_t>(p)];
+  }
+  return a.id;
+}
+
 TrainSummary Trainer::run() {
   fs::create_directories(o_.run_dir);
   const fs::path dir(o_.run_dir);
@@ -328,6 +347,12 @@ TrainSummary Trainer::run() {
     // One episode.
     env_->reset(mix(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
     episode_.clear();
+    // The draw is skipped when demonstrations are off, so runs without them keep their streams.
+    const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
+    const bool demo = share > 0.0 && explore_.rng().uniform() < share;
+    if (demo) {
+      demo_.begin_episode();
+    }
     float ep_return = 0.0F;
     int steps = 0;
     StepResult sr;
@@ -335,7 +360,7 @@ TrainSummary Trainer::run() {
       const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                         exploration_.epsilon_anneal_updates);
       ddpg_.act(obs_, net_out_);
-      const int id = explore_.select(net_out_, eps, stored_);
+      const int id = demo ? store_demo_action() : explore_.select(net_out_, eps, stored_);
       sr = env_->step({id, std::span<const float>(stored_).subspan(static_cast<size_t>(num_actions))}, next_obs_);
       episode_.push(obs_, stored_, sr.reward, next_obs_);
       ep_return += sr.reward;
@@ -379,7 +404,9 @@ TrainSummary Trainer::run() {
     backend_->sync_actor_to_host();
     ++episodes_;
     const bool success = sr.status == env_->success_status();
-    recent_.add(ep_return, steps, success);
+    if (!demo) {  // the training rates are the agent's own
+      recent_.add(ep_return, steps, success);
+    }
     if (o_.metrics != nullptr) {
       o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()));
     }
@@ -390,7 +417,8 @@ TrainSummary Trainer::run() {
     ep.ret = ep_return;
     ep.steps = steps;
     ep.outcome = env_->status_name(sr.status);
-    ep.weights_version = static_cast<uint64_t>(ddpg_.updates());  // one process: always the newest weights
+    // One process: always the newest weights; 0 marks an episode the scripted offense played.
+    ep.weights_version = demo ? 0 : static_cast<uint64_t>(ddpg_.updates());
     logs_->episode(ep);
     if (bar_) {
       bar_->update(ddpg_.updates());

@@ -100,6 +100,12 @@ TEST(Exploration, EpsilonSchedules) {
   EXPECT_DOUBLE_EQ(apex_epsilon(0, 8), 0.4);
   EXPECT_NEAR(apex_epsilon(7, 8), 0.00065536, 1e-12);
   EXPECT_DOUBLE_EQ(apex_epsilon(0, 1), 0.4);
+  // Demonstrations: constant without an anneal, else linear down to 0.
+  EXPECT_DOUBLE_EQ(demo_share(123456, 0.3, 0), 0.3);
+  EXPECT_DOUBLE_EQ(demo_share(0, 0.5, 100), 0.5);
+  EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100), 0.25);
+  EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100), 0.0);
+  EXPECT_DOUBLE_EQ(demo_share(5000, 0.5, 100), 0.0);
 }
 
 TEST(Exploration, RandomActionsFollowThePaper) {
@@ -315,6 +321,75 @@ std::vector<float> params_of(const std::string& ckpt, const app::ExperimentConfi
   return all;
 }
 
+struct EpisodeCsvRow {
+  int64_t updates = 0;
+  std::string outcome;
+  std::string weights_version;
+};
+
+std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<EpisodeCsvRow> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cols;
+    std::stringstream ss(line);
+    std::string col;
+    while (std::getline(ss, col, ',')) {
+      cols.push_back(col);
+    }
+    if (cols.size() == 8) {
+      rows.push_back({std::stoll(cols[2]), cols[6], cols[7]});
+    }
+  }
+  return rows;
+}
+
+app::ExperimentConfig hfo_demo_config(double demo_fraction, int64_t episodes) {
+  app::ExperimentConfig c =
+      app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/fast.toml",
+                                  {"train.max_updates=100000000", "train.eval_every_updates=0", "train.eval_episodes=0",
+                                   "train.confirm_episodes=0", "train.log_every_seconds=1000000000"});
+  c.train.max_episodes = episodes;
+  c.exploration.demo_fraction = demo_fraction;
+  return c;
+}
+
+TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
+  // All demonstrations: the scripted offense scores ~.998 on the empty goal; every episode is
+  // marked with weights_version 0, also after the updates began.
+  const fs::path dir = fresh_dir("demo");
+  app::train(hfo_demo_config(1.0, 30), {dir.string(), false, true, nullptr});
+  const auto rows = episode_rows(dir / "episodes.csv");
+  ASSERT_EQ(rows.size(), 30U);
+  EXPECT_GT(rows.back().updates, 0) << "the demonstrations filled the warm-up and fed the updates";
+  int goals = 0;
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.weights_version, "0");
+    goals += r.outcome == "GOAL" ? 1 : 0;
+  }
+  EXPECT_GE(goals, 27);
+  fs::remove_all(dir);
+
+  // None: the fresh actor, random (ε = 1) until the warm-up ends, then ε-greedy, does not score;
+  // once updates run, every episode carries the update count.
+  const fs::path none = fresh_dir("nodemo");
+  app::train(hfo_demo_config(0.0, 30), {none.string(), false, true, nullptr});
+  goals = 0;
+  int64_t acted = 0;
+  for (const auto& r : episode_rows(none / "episodes.csv")) {
+    goals += r.outcome == "GOAL" ? 1 : 0;
+    if (r.updates > 0) {
+      ++acted;
+      EXPECT_EQ(r.weights_version, std::to_string(r.updates));
+    }
+  }
+  EXPECT_GT(acted, 0);
+  EXPECT_LE(goals, 3);
+  fs::remove_all(none);
+}
+
 TEST(Train, ResumeIsBitForBit) {
   const fs::path a = fresh_dir("straight");
   const fs::path b = fresh_dir("halves");
@@ -457,6 +532,8 @@ TEST(Config, ErrorsNameTheKeyAndTheChoices) {
   expect_error("[ddpg\n", {}, "not valid TOML");
   expect_error("", {"ddpg.gamma"}, "expected key=value");
   expect_error("[replay]\nwarmup = 10\n", {}, "replay.warmup must be at least ddpg.batch_size");
+  expect_error("[env]\nname = 'reach_stop'\n[exploration]\ndemo_fraction = 0.5\n", {},
+               "exploration.demo_fraction > 0 needs the scripted offense");
 }
 
 TEST(Config, UpdateDevice) {
