@@ -49,8 +49,8 @@ source "$src/tests/system/cluster_lib.sh"
 batch=64      # cluster.actor_batch_transitions
 send_hwm=8    # the actor's batches queued per shard (actor/actor_loop.hpp shard_send_hwm)
 recv_hwm=16   # the shard's batches queued per actor (replay/shard_server.hpp insert_recv_hwm)
-ratio=32      # samples per insert: updates_per_step 1 x batch_size 32
-common+=(--set replay.capacity=20000 --set replay.warmup=1000 --set "cluster.actor_batch_transitions=$batch"
+ratio=32      # samples per insert: updates_per_step 1 (set here; fast.toml has 0.5) x batch_size 32
+common+=(--set train.updates_per_step=1 --set replay.capacity=20000 --set replay.warmup=1000 --set "cluster.actor_batch_transitions=$batch"
   --set train.checkpoint_every_seconds=0)
 
 rss_kb() { awk '$1 == "VmRSS:" { print $2 }' "/proc/$1/status" 2>/dev/null || echo 0; }
