@@ -260,8 +260,10 @@ TrainMetrics::TrainMetrics(Registry& r, const Env& env, int64_t replay_capacity)
   register_rate(r, env_steps_, "pamdp_env_steps_per_second", "Env steps per second over the last second or more");
 }
 
-void TrainMetrics::on_episode(int status, double ret, int steps, int64_t replay_size) {
-  episodes_.add(status, ret, steps);
+void TrainMetrics::on_episode(int status, double ret, int steps, int64_t replay_size, bool agent) {
+  if (agent) {
+    episodes_.add(status, ret, steps);
+  }
   inserted_.add(steps);
   size_.set(static_cast<double>(replay_size));
   fill_.set(capacity_ > 0.0 ? static_cast<double>(replay_size) / capacity_ : 0.0);

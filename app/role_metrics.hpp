@@ -151,8 +151,9 @@ class TrainMetrics {
     updates_.add(s, updates_total);
     sampled_.add(batch_size);
   }
-  // After the episode's transitions went into the replay buffer.
-  void on_episode(int status, double ret, int steps, int64_t replay_size);
+  // After the episode's transitions went into the replay buffer. A demonstration (`agent` false)
+  // counts as inserted transitions only, not in the episode outcomes and rates.
+  void on_episode(int status, double ret, int steps, int64_t replay_size, bool agent = true);
   void on_eval(const EvalResult& e) { evals_.add(e); }
 
  private:

@@ -408,7 +408,7 @@ TrainSummary Trainer::run() {
       recent_.add(ep_return, steps, success);
     }
     if (o_.metrics != nullptr) {
-      o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()));
+      o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()), !demo);
     }
     EpisodeRow ep;
     ep.episode = episodes_;
