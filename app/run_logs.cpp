@@ -206,11 +206,15 @@ bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<E
   if (!beats_best(r)) {
     return false;
   }
-  const EvalResult result = confirm ? confirm() : r;
+  // A screen without a single success is not worth a confirmation (1,000 episodes that run to
+  // the time limit, early in every run): it can only be compared by return, and the first
+  // screen with successes replaces it anyway.
+  const bool confirming = confirm && r.goal_rate > 0.0;
+  const EvalResult result = confirming ? confirm() : r;
   if (kept != nullptr) {
     *kept = result;
   }
-  if (confirm) {
+  if (confirming) {
     const bool better = beats_best(result);
     log::info("{}: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}: {}",
               role_, updates, r.goal_rate, r.episodes, result.goal_rate, result.avg_steps_to_goal, result.episodes,

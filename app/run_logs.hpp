@@ -107,7 +107,7 @@ class BestEval {
   // True when the (confirmed) result beats every one kept before (the first one always does);
   // then the file is rewritten (atomically) with it and `updates`. `kept`, when given, receives
   // the result that was compared (the confirmation's, when one ran). A confirmation is logged
-  // with both results and the verdict.
+  // with both results and the verdict. A result without successes is kept unconfirmed.
   bool offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm = {},
              EvalResult* kept = nullptr);
   [[nodiscard]] const std::optional<EvalResult>& best() const { return best_; }

@@ -195,7 +195,12 @@ TEST(BestEval, ACandidateIsJudgedByItsConfirmation) {
   {
     BestEval best(file);
     EvalResult kept;
-    // The first candidate is confirmed, and the confirmation is what is kept.
+    // A screen without successes is kept as it is, without a confirmation.
+    EXPECT_TRUE(best.offer(eval_of(0.0, 0.0, 2.0), 5, confirming(0.5, 75.0), &kept));
+    EXPECT_EQ(confirmations, 0);
+    EXPECT_DOUBLE_EQ(kept.goal_rate, 0.0);
+    EXPECT_DOUBLE_EQ(best.best()->avg_return, 2.0);
+    // The first candidate with successes is confirmed, and the confirmation is what is kept.
     EXPECT_TRUE(best.offer(eval_of(1.0, 70.0, 0.0), 10, confirming(0.93, 75.0), &kept));
     EXPECT_EQ(confirmations, 1);
     EXPECT_DOUBLE_EQ(kept.goal_rate, 0.93);
