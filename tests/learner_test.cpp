@@ -370,6 +370,37 @@ TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
     goals += r.outcome == "GOAL" ? 1 : 0;
   }
   EXPECT_GE(goals, 27);
+  // Every stored action is the scripted offense's, written as an actor output: score 1 for the
+  // action it took and -1 for the others, its parameters within their bounds.
+  const app::ExperimentConfig demo_config = hfo_demo_config(1.0, 30);
+  const hfo::HfoEnv env;
+  const ActionSpace& space = env.action_space();
+  ReplayBuffer replay(demo_config.replay.capacity, env.observation_size(), space.output_width());
+  load_replay_snapshot((dir / "replay.bin").string(), replay);
+  ASSERT_GT(replay.size(), 1000);
+  const auto raw = replay.raw();
+  const int64_t row = 2LL * env.observation_size() + space.output_width() + 3;
+  std::vector<int> taken(static_cast<size_t>(space.num_actions()), 0);
+  for (int64_t i = 0; i < replay.size(); ++i) {
+    const float* a = raw.data() + i * row + env.observation_size();
+    int chosen = -1;
+    for (int k = 0; k < space.num_actions(); ++k) {
+      ASSERT_TRUE(a[k] == 1.0F || a[k] == -1.0F) << "row " << i << " score " << k << " = " << a[k];
+      if (a[k] == 1.0F) {
+        ASSERT_EQ(chosen, -1) << "row " << i << " has two chosen actions";
+        chosen = k;
+      }
+    }
+    ASSERT_NE(chosen, -1) << "row " << i;
+    ++taken[static_cast<size_t>(chosen)];
+    for (const int p : space.actions[static_cast<size_t>(chosen)].param_indices) {
+      const ParamSpec& spec = space.params[static_cast<size_t>(p)];
+      const float v = a[space.num_actions() + p];
+      EXPECT_TRUE(v >= spec.lo && v <= spec.hi) << "row " << i << " " << spec.name << " = " << v;
+    }
+  }
+  EXPECT_GT(taken[static_cast<size_t>(space.find_action("DASH"))], 0);
+  EXPECT_GT(taken[static_cast<size_t>(space.find_action("KICK"))], 0);
   fs::remove_all(dir);
 
   // None: the fresh actor, random (ε = 1) until the warm-up ends, then ε-greedy, does not score;
