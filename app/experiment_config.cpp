@@ -65,6 +65,8 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("ddpg.critic_output_init_std", c.ddpg.critic_output_init_std, 0.0, 10.0);
   v.real("ddpg.critic_output_init_bias", c.ddpg.critic_output_init_bias, -1e6, 1e6);
   v.choice("ddpg.device", c.ddpg.device, kDevices);
+  v.real("ddpg.demo_bc_weight", c.ddpg.demo_bc_weight, 0.0, 1e6);
+  v.boolean("ddpg.demo_q_filter", c.ddpg.demo_q_filter);
 
   v.real("exploration.epsilon_start", c.exploration.epsilon_start, 0.0, 1.0);
   v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);
@@ -414,6 +416,12 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
                              "HFO features: use env.name = \"hfo\" (or hfo-server with env.server_encoding = "
                              "\"embedded\"), or set exploration.demo_fraction = 0");
+  }
+  if (c.ddpg.demo_bc_weight > 0.0 && c.exploration.demo_fraction <= 0.0) {
+    throw std::runtime_error(src +
+                             ": ddpg.demo_bc_weight > 0 clones demonstrations, and there are none: set "
+                             "exploration.demo_fraction > 0 (the share of episodes the scripted offense plays), or "
+                             "ddpg.demo_bc_weight = 0");
   }
 }
 

@@ -1,5 +1,6 @@
 #include "app/trainer.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -58,20 +59,25 @@ class EpisodeBuffer {
     ++n_;
   }
   // Inserts every transition with its discounted return; the last one is terminal if the
-  // episode ended (always, here: time-outs count as terminals as in the paper's code).
-  void flush(ReplayBuffer& replay, double gamma) {
+  // episode ended (always, here: time-outs count as terminals as in the paper's code). `also`,
+  // when given, receives the same transitions.
+  void flush(ReplayBuffer& replay, double gamma, ReplayBuffer* also = nullptr) {
     double g = 0.0;
     for (size_t i = n_; i-- > 0;) {
       g = rewards_[i] + gamma * g;
       returns_[i] = static_cast<float>(g);
     }
     for (size_t i = 0; i < n_; ++i) {
-      replay.insert({{states_.data() + i * obs_, obs_},
-                     {actions_.data() + i * act_, act_},
-                     rewards_[i],
-                     {next_.data() + i * obs_, obs_},
-                     i + 1 == n_,
-                     returns_[i]});
+      const TransitionView t{{states_.data() + i * obs_, obs_},
+                             {actions_.data() + i * act_, act_},
+                             rewards_[i],
+                             {next_.data() + i * obs_, obs_},
+                             i + 1 == n_,
+                             returns_[i]};
+      replay.insert(t);
+      if (also != nullptr) {
+        also->insert(t);
+      }
     }
     n_ = 0;
   }
@@ -106,7 +112,16 @@ class Trainer {
         obs_(static_cast<size_t>(obs_dim_)),
         next_obs_(static_cast<size_t>(obs_dim_)),
         net_out_(static_cast<size_t>(width_)),
-        stored_(static_cast<size_t>(width_)) {}
+        stored_(static_cast<size_t>(width_)) {
+    if (c.ddpg.demo_bc_weight > 0.0) {
+      cpu_backend_ = dynamic_cast<CpuUpdateBackend*>(backend_.get());
+      if (cpu_backend_ == nullptr) {
+        throw std::logic_error("train: cloning demonstrations needs the CPU update backend");
+      }
+      demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
+      demo_batch_.emplace(obs_dim_, width_, c.ddpg.batch_size);
+    }
+  }
 
   TrainSummary run();
 
@@ -137,6 +152,11 @@ class Trainer {
   // run still replays the same actions; on the CPU every sync is a no-op.
   std::unique_ptr<UpdateBackend> backend_;
   ReplayBuffer replay_;
+  // With ddpg.demo_bc_weight > 0: the demonstrated transitions again, kept for cloning (they
+  // also go into replay_), and the backend, which is then the CPU one.
+  std::optional<ReplayBuffer> demo_replay_;
+  std::optional<BatchBuffers> demo_batch_;
+  CpuUpdateBackend* cpu_backend_ = nullptr;
   EpsilonGreedy explore_;
   hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
   Rng sample_rng_;
@@ -178,6 +198,9 @@ void Trainer::resume() {
   update_credit_ = meta.update_credit;
   base_seconds_ = meta.elapsed_seconds;
   load_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
+  if (demo_replay_) {
+    load_replay_snapshot((fs::path(o_.run_dir) / "demo_replay.bin").string(), *demo_replay_);
+  }
 }
 
 void Trainer::save() {
@@ -190,6 +213,9 @@ void Trainer::save() {
   meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
   // Replay first: a checkpoint on disk always has a replay snapshot at least as new.
   save_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
+  if (demo_replay_) {
+    save_replay_snapshot((fs::path(o_.run_dir) / "demo_replay.bin").string(), *demo_replay_);
+  }
   backend_->sync_to_host();
   save_checkpoint((fs::path(o_.run_dir) / "checkpoint.ckpt").string(), ddpg_, meta);
   last_checkpoint_ = elapsed();
@@ -276,7 +302,9 @@ void Trainer::log_tick(bool force) {
   if (have_eval_) {
     row.eval = last_eval_;
   }
-  logs_->metrics(row);  // flushes the episode log too, so a killed run keeps it up to this row
+  const std::array<double, 2> bc{last_stats_.bc_accepted_fraction, last_stats_.bc_loss};
+  // Flushes the episode log too, so a killed run keeps it up to this row.
+  logs_->metrics(row, demo_replay_ ? std::span<const double>(bc) : std::span<const double>{});
   if (!o_.quiet) {
     if (bar_) {
       bar_->clear();
@@ -330,7 +358,10 @@ TrainSummary Trainer::run() {
   if (o_.resume) {
     resume_at = ResumePoint{static_cast<int64_t>(ddpg_.updates()), static_cast<int64_t>(episodes_)};
   }
-  logs_.emplace(dir, std::vector<std::string>{}, resume_at);
+  // With cloning, metrics.csv also says how much of it the Q-filter lets through.
+  logs_.emplace(dir,
+                demo_replay_ ? std::vector<std::string>{"bc_accepted_fraction", "bc_loss"} : std::vector<std::string>{},
+                resume_at);
   best_.emplace(dir / "best_eval.txt");
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);
@@ -385,7 +416,20 @@ TrainSummary Trainer::run() {
             Eigen::Map<const Eigen::VectorXf>(batch_.terminal.data(), B),
             Eigen::Map<const Eigen::VectorXf>(batch_.mc_returns.data(), B),
         };
-        last_stats_ = backend_->update(view);
+        if (demo_replay_ && demo_replay_->size() > 0) {
+          demo_replay_->sample(sample_rng_, B, *demo_batch_);
+          const BatchView demos{
+              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->states.data(), obs_dim_, B),
+              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->actions.data(), width_, B),
+              Eigen::Map<const Eigen::VectorXf>(demo_batch_->rewards.data(), B),
+              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->next_states.data(), obs_dim_, B),
+              Eigen::Map<const Eigen::VectorXf>(demo_batch_->terminal.data(), B),
+              Eigen::Map<const Eigen::VectorXf>(demo_batch_->mc_returns.data(), B),
+          };
+          last_stats_ = cpu_backend_->update(view, demos);
+        } else {
+          last_stats_ = backend_->update(view);
+        }
         if (o_.metrics != nullptr) {
           o_.metrics->on_update(last_stats_, ddpg_.updates(), B);
         }
@@ -400,7 +444,7 @@ TrainSummary Trainer::run() {
       log_tick(false);
     } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
 
-    episode_.flush(replay_, c_.ddpg.gamma);
+    episode_.flush(replay_, c_.ddpg.gamma, demo && demo_replay_ ? &*demo_replay_ : nullptr);
     backend_->sync_actor_to_host();
     ++episodes_;
     const bool success = sr.status == env_->success_status();

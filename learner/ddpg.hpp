@@ -6,6 +6,13 @@
 // One update: critic step on the (optionally Monte-Carlo-mixed) TD target with target
 // networks, then an actor step through the just-updated critic (critic parameter gradients of
 // that pass discarded), then soft target updates. update() allocates nothing; not thread-safe.
+//
+// With demonstrations (demo_bc_weight > 0 and a batch of demonstrated transitions), the actor
+// step also clones them (DDPGfD, Nair et al. 2018 "Overcoming exploration in RL with
+// demonstrations"): L = -sum Q(s, pi(s)) over the batch + demo_bc_weight * sum 1/2 |pi(s_d) -
+// a_d|^2 over the demonstrations where the critic rates the demonstrated action above the
+// actor's own (the Q-filter), each output measured in units of half its range (scores and
+// the demonstrated action's parameters; the other parameters carry no demonstration).
 #pragma once
 
 #include <Eigen/Core>
@@ -46,6 +53,9 @@ struct DdpgConfig {
   double critic_output_init_std = 0.05;  // the paper-era code's critic output layer
   double critic_output_init_bias = 1.0;
   UpdateDevice device = UpdateDevice::kAuto;  // read by make_update_backend, not by Ddpg itself
+  // Behaviour cloning of demonstrations (see the top of this file); 0 disables. CPU only.
+  double demo_bc_weight = 0.0;
+  bool demo_q_filter = true;  // clone only where Q(s, a_demo) > Q(s, pi(s))
 };
 
 // A minibatch, one sample per column. Not owned.
@@ -67,6 +77,10 @@ struct UpdateStats {
   // Continuous parameters of the batch's actor outputs at or past a bound of their range (a
   // health check of the gradient bounding; W x B compares).
   float params_at_bound_fraction = 0.0F;
+  // With demonstrations: the share of them the Q-filter let through, and their cloning loss
+  // (demo_bc_weight * mean over the demonstrations of 1/2 |pi(s_d) - a_d|^2, filtered ones 0).
+  float bc_accepted_fraction = 0.0F;
+  float bc_loss = 0.0F;
 };
 
 class Ddpg {
@@ -80,7 +94,9 @@ class Ddpg {
   [[nodiscard]] int obs_dim() const { return obs_dim_; }
   [[nodiscard]] int num_actions() const { return num_actions_; }  // discrete scores before the parameters
 
-  UpdateStats update(const BatchView& batch);
+  // `demos`, when given and demo_bc_weight > 0, is a batch of demonstrated transitions (states
+  // and actions are read; at most batch_size of them) cloned by the actor step.
+  UpdateStats update(const BatchView& batch, const BatchView* demos = nullptr);
   [[nodiscard]] int64_t updates() const { return updates_; }
   // Sets both optimizers' learning rates for the next update from the decay schedule and
   // updates(); update() calls it, and so does any other backend before each step.
@@ -112,13 +128,18 @@ class Ddpg {
   int64_t updates_ = 0;
   int num_actions_ = 0;  // the discrete scores come first in the output; parameters follow
 
-  // Scratch, sized for batch_size in the constructor.
-  Eigen::MatrixXf critic_in_;  // (obs + width) x B
-  Eigen::MatrixXf actions_;    // width x B (executed/squashed outputs)
-  Eigen::MatrixXf targets_;    // 1 x B
-  Eigen::MatrixXf d_q_;        // 1 x B
-  Eigen::MatrixXf d_action_;   // width x B
-  Eigen::MatrixXf single_in_;  // obs x 1
+  // Scratch, sized in the constructor for batch_size (twice that with demonstrations: the
+  // actor step runs the batch and the demonstrations as one).
+  Eigen::MatrixXf critic_in_;            // (obs + width) x B
+  Eigen::MatrixXf actions_;              // width x B (executed/squashed outputs)
+  Eigen::MatrixXf targets_;              // 1 x B
+  Eigen::MatrixXf d_q_;                  // 1 x B
+  Eigen::MatrixXf d_action_;             // width x B
+  Eigen::MatrixXf single_in_;            // obs x 1
+  Eigen::MatrixXf states_in_;            // obs x 2B: the batch's states, then the demonstrations'
+  Eigen::MatrixXf demo_q_;               // 1 x B: Q(s_d, a_d)
+  std::vector<float> bc_scale_;          // per output: 2 / (hi - lo), squared in the loss's gradient
+  std::vector<std::vector<int>> owned_;  // per discrete action: its output rows (score, parameters)
 };
 
 }  // namespace pamdp

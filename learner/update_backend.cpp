@@ -21,6 +21,16 @@ std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice devi
   if (device == UpdateDevice::kCpu) {
     return std::make_unique<CpuUpdateBackend>(ddpg);
   }
+  if (ddpg.config().demo_bc_weight > 0.0) {
+    // The CUDA update has no cloning term (learner/ddpg.hpp).
+    if (device == UpdateDevice::kCuda) {
+      throw std::runtime_error(
+          "ddpg.device = \"cuda\" cannot clone demonstrations (ddpg.demo_bc_weight > 0 runs on the CPU only); use "
+          "ddpg.device = \"cpu\" or \"auto\", or set ddpg.demo_bc_weight = 0");
+    }
+    log::info("learner: ddpg.device = auto: ddpg.demo_bc_weight > 0 runs on the CPU; updates run on the CPU");
+    return std::make_unique<CpuUpdateBackend>(ddpg);
+  }
   std::string why;
   const bool have_device = cuda_device_count(&why) > 0;
   if (device == UpdateDevice::kCuda) {

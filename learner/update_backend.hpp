@@ -58,6 +58,11 @@ class CpuUpdateBackend final : public UpdateBackend {
     last_ = ddpg_.update(batch);
     return last_;
   }
+  // With demonstrations to clone (Ddpg::update); only the CPU backend has it.
+  UpdateStats update(const BatchView& batch, const BatchView& demos) {
+    last_ = ddpg_.update(batch, &demos);
+    return last_;
+  }
   UpdateStats finish() override { return last_; }
   void sync_to_host() override {}
   void sync_actor_to_host() override {}
@@ -70,7 +75,8 @@ class CpuUpdateBackend final : public UpdateBackend {
 // kCpu: the CPU backend. kCuda: the CUDA backend on device 0; throws std::runtime_error with a
 // one-line message naming the problem and the fix when this build has no CUDA support or no
 // device is usable. kAuto: CUDA when a device is usable (and the backend can be built on it),
-// else the CPU; logs which it took and why.
+// else the CPU; logs which it took and why. With ddpg.demo_bc_weight > 0 always the CPU (kCuda
+// throws).
 std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice device);
 
 // Number of usable CUDA devices (0 in a build without CUDA, without a driver or without a

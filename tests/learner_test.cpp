@@ -257,6 +257,104 @@ TEST(Ddpg, LearningRatesDecayLinearlyThenHold) {
   EXPECT_EQ(constant.actor_optimizer().config().learning_rate, 1e-3);
 }
 
+// The actor step with demonstrations descends L = -sum Q(s, pi(s)) over the batch + lambda *
+// sum over the demonstrations the Q-filter lets through of 1/2 |pi(s_d) - a_d|^2 (the scores
+// and the demonstrated action's parameters, in units of half their range). Its gradient is
+// recovered exactly from the first Adam step and compared with finite differences of L.
+TEST(Ddpg, CloningGradientMatchesFiniteDifferences) {
+  toy::ReachStopEnv env;
+  const ActionSpace& space = env.action_space();  // MOVE(velocity in [-1, 1]), STOP
+  DdpgConfig c = tiny_config();
+  c.bound = BoundMethod::kZeroing;  // the identity while no output is at a bound
+  c.clip_grad_norm = 0.0;
+  c.init_std = 0.3;
+  c.actor_learning_rate = 100.0;  // first step: delta = -lr k g / (k |g| + eps), k = sqrt(1 - beta2)
+  c.adam_epsilon = 100.0;
+  c.demo_bc_weight = 3.0;
+  for (const bool filter : {true, false}) {
+    c.demo_q_filter = filter;
+    Ddpg d(3, space, c, 2);
+    BatchBuffers b(3, 3, 4);
+    BatchBuffers demo(3, 3, 4);
+    Rng rng(9);
+    for (auto* v : {&b.states, &b.actions, &b.next_states, &demo.states}) {
+      for (float& x : *v) {
+        x = static_cast<float>(rng.uniform(-1, 1));
+      }
+    }
+    b.rewards = {1, 0, -1, 0.5F};
+    b.terminal = {0, 1, 0, 0};
+    // MOVE at 0.8 and -0.6, then STOP twice (its velocity entry is not a demonstration).
+    demo.actions = {1, -1, 0.8F, 1, -1, -0.6F, -1, 1, 0.5F, -1, 1, -0.9F};
+    const BatchView batch = view_of(b, 3, 3, 4);
+    const BatchView demos = view_of(demo, 3, 3, 4);
+    const std::vector<float> before(d.actor().params().begin(), d.actor().params().end());
+    const UpdateStats stats = d.update(batch, &demos);
+    std::vector<float> after(d.actor().params().begin(), d.actor().params().end());
+
+    // L at actor parameters theta, with the critic as the actor step saw it (updated once).
+    auto critic_q = [&](const Eigen::MatrixXf& s, const Eigen::MatrixXf& a) {
+      Eigen::MatrixXf in(6, 4);
+      in.topRows(3) = s;
+      in.bottomRows(3) = a;
+      return Eigen::MatrixXf(d.critic().forward(in));
+    };
+    const Eigen::MatrixXf s_b = batch.states;
+    const Eigen::MatrixXf s_d = demos.states;
+    const Eigen::MatrixXf a_d = demos.actions;
+    std::copy(before.begin(), before.end(), d.actor().params().begin());
+    const Eigen::MatrixXf pi_d0 = d.actor().forward(s_d);
+    const Eigen::MatrixXf q_demo = critic_q(s_d, a_d);
+    const Eigen::MatrixXf q_pi = critic_q(s_d, pi_d0);
+    const Eigen::MatrixXf pi_b0 = d.actor().forward(s_b);
+    ASSERT_LT(std::max(pi_d0.cwiseAbs().maxCoeff(), pi_b0.cwiseAbs().maxCoeff()), 1.0F)
+        << "an output at a bound: zeroing would drop its gradient";
+    std::vector<bool> take(4);
+    int taken = 0;
+    for (int j = 0; j < 4; ++j) {
+      take[static_cast<size_t>(j)] = !filter || q_demo(0, j) > q_pi(0, j);
+      taken += take[static_cast<size_t>(j)] ? 1 : 0;
+    }
+    EXPECT_FLOAT_EQ(stats.bc_accepted_fraction, static_cast<float>(taken) / 4.0F);
+    if (filter) {
+      EXPECT_GT(taken, 0);
+      EXPECT_LT(taken, 4) << "pick another seed: the filter should drop some demonstrations";
+    }
+    auto loss = [&]() {
+      const Eigen::MatrixXf pi_b = d.actor().forward(s_b);
+      double l = -static_cast<double>(critic_q(s_b, pi_b).sum());
+      const Eigen::MatrixXf pi_d = d.actor().forward(s_d);
+      for (int j = 0; j < 4; ++j) {
+        if (!take[static_cast<size_t>(j)]) {
+          continue;
+        }
+        const bool move = a_d(0, j) > a_d(1, j);
+        for (int i = 0; i < (move ? 3 : 2); ++i) {  // scores, and velocity when MOVE
+          const double diff = pi_d(i, j) - a_d(i, j);
+          l += 0.5 * c.demo_bc_weight * diff * diff;  // every range here is 2: unit scale
+        }
+      }
+      return l;
+    };
+    const double k = std::sqrt(1.0 - c.adam_beta2);
+    int checked = 0;
+    for (size_t i = 0; i < before.size(); ++i) {
+      const double delta = static_cast<double>(after[i]) - before[i];
+      const double g = -delta * c.adam_epsilon / (k * (c.actor_learning_rate - std::abs(delta)));
+      const float h = 1e-3F;
+      d.actor().params()[i] = before[i] + h;
+      const double up = loss();
+      d.actor().params()[i] = before[i] - h;
+      const double down = loss();
+      d.actor().params()[i] = before[i];
+      const double fd = (up - down) / (2.0 * h);
+      EXPECT_NEAR(g, fd, 2e-3 + 2e-2 * std::abs(fd)) << "actor parameter " << i << (filter ? " (filter)" : "");
+      checked += std::abs(fd) > 1e-2 ? 1 : 0;
+    }
+    EXPECT_GT(checked, 10);
+  }
+}
+
 TEST(Ddpg, CriticLearnsAFixedTarget) {
   // Terminal transitions with reward r: the critic must regress Q(s, a) onto r.
   toy::ReachStopEnv env;
@@ -323,6 +421,7 @@ std::vector<float> params_of(const std::string& ckpt, const app::ExperimentConfi
 
 struct EpisodeCsvRow {
   int64_t updates = 0;
+  int64_t steps = 0;
   std::string outcome;
   std::string weights_version;
 };
@@ -340,7 +439,7 @@ std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
       cols.push_back(col);
     }
     if (cols.size() == 8) {
-      rows.push_back({std::stoll(cols[2]), cols[6], cols[7]});
+      rows.push_back({std::stoll(cols[2]), std::stoll(cols[5]), cols[6], cols[7]});
     }
   }
   return rows;
@@ -419,6 +518,54 @@ TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
   EXPECT_GT(acted, 0);
   EXPECT_LE(goals, 3);
   fs::remove_all(none);
+}
+
+TEST(Train, CloningIsLoggedAndItsDemonstrationsSurviveAResume) {
+  // ddpg.demo_bc_weight > 0: the demonstrated transitions are kept apart for cloning (and
+  // saved with the checkpoint), and metrics.csv says how many the Q-filter let through.
+  const fs::path dir = fresh_dir("clone");
+  app::ExperimentConfig c = hfo_demo_config(0.5, 20);
+  c.ddpg.demo_bc_weight = 1.0;
+  app::train(c, {dir.string(), false, true, nullptr});
+  ASSERT_TRUE(fs::exists(dir / "demo_replay.bin"));
+  const hfo::HfoEnv env;
+  const int width = env.action_space().output_width();
+  // Demonstrations are the episodes with weights_version 0 once updates run; the episodes
+  // before the first update carry 0 whoever played them.
+  auto expect_every_demonstrated_step = [&](const char* when) {
+    ReplayBuffer demos(c.replay.capacity, env.observation_size(), width);
+    load_replay_snapshot((dir / "demo_replay.bin").string(), demos);
+    int64_t known = 0;
+    int64_t unsure = 0;
+    for (const auto& r : episode_rows(dir / "episodes.csv")) {
+      if (r.weights_version == "0") {
+        (r.updates > 0 ? known : unsure) += r.steps;
+      }
+    }
+    EXPECT_GT(known, 0);
+    EXPECT_GE(demos.size(), known) << when;
+    EXPECT_LE(demos.size(), known + unsure) << when;
+  };
+  expect_every_demonstrated_step("after the first run");
+
+  std::ifstream metrics(dir / "metrics.csv");
+  std::string header;
+  std::string line;
+  std::string last;
+  std::getline(metrics, header);
+  while (std::getline(metrics, line)) {
+    last = line;
+  }
+  ASSERT_NE(header.find(",bc_accepted_fraction,bc_loss"), std::string::npos) << header;
+  const std::string accepted = last.substr(0, last.rfind(','));
+  const double fraction = std::stod(accepted.substr(accepted.rfind(',') + 1));
+  EXPECT_GE(fraction, 0.0);
+  EXPECT_LE(fraction, 1.0);
+
+  c.train.max_episodes = 30;
+  app::train(c, {dir.string(), true, true, nullptr});
+  expect_every_demonstrated_step("after the resume: the demonstrations before it were kept");
+  fs::remove_all(dir);
 }
 
 TEST(Train, ResumeIsBitForBit) {
@@ -565,6 +712,9 @@ TEST(Config, ErrorsNameTheKeyAndTheChoices) {
   expect_error("[replay]\nwarmup = 10\n", {}, "replay.warmup must be at least ddpg.batch_size");
   expect_error("[env]\nname = 'reach_stop'\n[exploration]\ndemo_fraction = 0.5\n", {},
                "exploration.demo_fraction > 0 needs the scripted offense");
+  expect_error("[ddpg]\ndemo_bc_weight = 1.0\n", {},
+               "ddpg.demo_bc_weight > 0 clones demonstrations, and there are none");
+  expect_error("[ddpg]\ndemo_bc_weight = -1.0\n", {}, "'ddpg.demo_bc_weight' must be within");
 }
 
 TEST(Config, UpdateDevice) {
@@ -607,6 +757,20 @@ TEST(UpdateBackend, CpuIsDdpgUpdate) {
 
 // Without a GPU (this machine, CI): "cuda" is refused in one line that names the fix, and "auto"
 // falls back to the CPU. With a GPU these are covered by tests/cuda_learner_test.cpp instead.
+TEST(UpdateBackend, CloningRunsOnTheCpu) {
+  toy::ReachStopEnv env;
+  DdpgConfig c = tiny_config();
+  c.demo_bc_weight = 1.0;
+  Ddpg d(3, env.action_space(), c, 5);
+  EXPECT_STREQ(make_update_backend(d, UpdateDevice::kAuto)->name(), "cpu");
+  try {
+    make_update_backend(d, UpdateDevice::kCuda);
+    FAIL() << "ddpg.device = cuda accepted with ddpg.demo_bc_weight > 0";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot clone demonstrations"), std::string::npos) << e.what();
+  }
+}
+
 TEST(UpdateBackend, CudaWithoutADeviceIsAClearError) {
   std::string why;
   if (cuda_device_count(&why) > 0) {

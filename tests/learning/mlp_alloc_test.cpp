@@ -1,5 +1,6 @@
-// Proves that Mlp::forward/backward and the optimizer steps allocate nothing (core/mlp.hpp,
-// core/optim.hpp) at the learner's batch (32) and the actors' (1).
+// Proves that Mlp::forward/backward, the optimizer steps and a whole DDPG update (with and
+// without demonstrations to clone) allocate nothing (core/mlp.hpp, core/optim.hpp,
+// learner/ddpg.hpp) at the learner's batch (32) and the actors' (1).
 //
 // Eigen allocates with std::malloc (its aligned_malloc over-allocates and aligns by hand), not
 // operator new, so replacing operator new alone would miss exactly the allocations this test
@@ -20,6 +21,8 @@
 #include "core/mlp.hpp"
 #include "core/optim.hpp"
 #include "core/rng.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "learner/ddpg.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define PAMDP_COUNT_MALLOC 0
@@ -177,6 +180,50 @@ TEST(OptimAllocations, StepClipAndSoftUpdateAllocateNothing) {
     allocations = scope.count();
   }
   EXPECT_EQ(allocations, 0);
+}
+
+TEST(DdpgAllocations, UpdateAllocatesNothing) {
+  if (!kCounting) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc";
+  }
+  const ActionSpace& space = hfo::hfo_action_space();
+  const int obs = 58;
+  const int width = space.output_width();
+  for (const double bc : {0.0, 1.0}) {
+    DdpgConfig c;
+    c.hidden = {256, 128, 64};
+    c.mc_mix = 0.5;
+    c.demo_bc_weight = bc;
+    Ddpg d(obs, space, c, 3);
+    const int B = c.batch_size;
+    Rng rng(4);
+    auto random = [&](int rows, int cols) {
+      Eigen::MatrixXf m(rows, cols);
+      for (float& x : m.reshaped()) {
+        x = static_cast<float>(rng.uniform(-1, 1));
+      }
+      return m;
+    };
+    const Eigen::MatrixXf s = random(obs, B);
+    const Eigen::MatrixXf a = random(width, B);
+    const Eigen::MatrixXf s2 = random(obs, B);
+    const Eigen::VectorXf r = random(B, 1);
+    const Eigen::VectorXf t = Eigen::VectorXf::Zero(B);
+    const BatchView batch{
+        Eigen::Map<const Eigen::MatrixXf>(s.data(), obs, B), Eigen::Map<const Eigen::MatrixXf>(a.data(), width, B),
+        Eigen::Map<const Eigen::VectorXf>(r.data(), B),      Eigen::Map<const Eigen::MatrixXf>(s2.data(), obs, B),
+        Eigen::Map<const Eigen::VectorXf>(t.data(), B),      Eigen::Map<const Eigen::VectorXf>(r.data(), B)};
+    d.update(batch, &batch);  // first-call work (none expected) out of the count
+    long allocations = 0;
+    {
+      CountAllocations scope;
+      for (int i = 0; i < 3; ++i) {
+        d.update(batch, &batch);
+      }
+      allocations = scope.count();
+    }
+    EXPECT_EQ(allocations, 0) << "demo_bc_weight " << bc;
+  }
 }
 
 }  // namespace
