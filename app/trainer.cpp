@@ -132,6 +132,8 @@ class Trainer {
   void run_eval();
   void save_best();
   int store_demo_action();
+  // A full sampled batch as the update reads it (no copy).
+  [[nodiscard]] BatchView view_of(const BatchBuffers& b) const;
   [[nodiscard]] bool should_stop() const;
   [[nodiscard]] double elapsed() const {
     return base_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -327,6 +329,18 @@ void Trainer::log_tick(bool force) {
 // The scripted offense's action for obs_, written into stored_ as the actor's output vector would
 // carry it: score 1 for its action and -1 for the others, its parameters, and the actor's own
 // output (net_out_) for the parameters of the other actions. Returns the action id.
+BatchView Trainer::view_of(const BatchBuffers& b) const {
+  const int B = c_.ddpg.batch_size;
+  return {
+      Eigen::Map<const Eigen::MatrixXf>(b.states.data(), obs_dim_, B),
+      Eigen::Map<const Eigen::MatrixXf>(b.actions.data(), width_, B),
+      Eigen::Map<const Eigen::VectorXf>(b.rewards.data(), B),
+      Eigen::Map<const Eigen::MatrixXf>(b.next_states.data(), obs_dim_, B),
+      Eigen::Map<const Eigen::VectorXf>(b.terminal.data(), B),
+      Eigen::Map<const Eigen::VectorXf>(b.mc_returns.data(), B),
+  };
+}
+
 int Trainer::store_demo_action() {
   const ParamAction a = demo_.act(obs_);
   const int num_actions = space_.num_actions();
@@ -408,27 +422,11 @@ TrainSummary Trainer::run() {
       while (update_credit_ >= 1.0 && replay_.size() >= c_.replay.warmup) {
         replay_.sample(sample_rng_, c_.ddpg.batch_size, batch_);
         const int B = c_.ddpg.batch_size;
-        const BatchView view{
-            Eigen::Map<const Eigen::MatrixXf>(batch_.states.data(), obs_dim_, B),
-            Eigen::Map<const Eigen::MatrixXf>(batch_.actions.data(), width_, B),
-            Eigen::Map<const Eigen::VectorXf>(batch_.rewards.data(), B),
-            Eigen::Map<const Eigen::MatrixXf>(batch_.next_states.data(), obs_dim_, B),
-            Eigen::Map<const Eigen::VectorXf>(batch_.terminal.data(), B),
-            Eigen::Map<const Eigen::VectorXf>(batch_.mc_returns.data(), B),
-        };
         if (demo_replay_ && demo_replay_->size() > 0) {
           demo_replay_->sample(sample_rng_, B, *demo_batch_);
-          const BatchView demos{
-              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->states.data(), obs_dim_, B),
-              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->actions.data(), width_, B),
-              Eigen::Map<const Eigen::VectorXf>(demo_batch_->rewards.data(), B),
-              Eigen::Map<const Eigen::MatrixXf>(demo_batch_->next_states.data(), obs_dim_, B),
-              Eigen::Map<const Eigen::VectorXf>(demo_batch_->terminal.data(), B),
-              Eigen::Map<const Eigen::VectorXf>(demo_batch_->mc_returns.data(), B),
-          };
-          last_stats_ = cpu_backend_->update(view, demos);
+          last_stats_ = cpu_backend_->update(view_of(batch_), view_of(*demo_batch_));
         } else {
-          last_stats_ = backend_->update(view);
+          last_stats_ = backend_->update(view_of(batch_));
         }
         if (o_.metrics != nullptr) {
           o_.metrics->on_update(last_stats_, ddpg_.updates(), B);
