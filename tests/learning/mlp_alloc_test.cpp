@@ -18,6 +18,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench/random_batch.hpp"
 #include "core/mlp.hpp"
 #include "core/optim.hpp"
 #include "core/rng.hpp"
@@ -187,32 +188,14 @@ TEST(DdpgAllocations, UpdateAllocatesNothing) {
     GTEST_SKIP() << "AddressSanitizer owns malloc";
   }
   const ActionSpace& space = hfo::hfo_action_space();
-  const int obs = 58;
-  const int width = space.output_width();
   for (const double bc : {0.0, 1.0}) {
     DdpgConfig c;
     c.hidden = {256, 128, 64};
     c.mc_mix = 0.5;
     c.demo_bc_weight = bc;
-    Ddpg d(obs, space, c, 3);
-    const int B = c.batch_size;
-    Rng rng(4);
-    auto random = [&](int rows, int cols) {
-      Eigen::MatrixXf m(rows, cols);
-      for (float& x : m.reshaped()) {
-        x = static_cast<float>(rng.uniform(-1, 1));
-      }
-      return m;
-    };
-    const Eigen::MatrixXf s = random(obs, B);
-    const Eigen::MatrixXf a = random(width, B);
-    const Eigen::MatrixXf s2 = random(obs, B);
-    const Eigen::VectorXf r = random(B, 1);
-    const Eigen::VectorXf t = Eigen::VectorXf::Zero(B);
-    const BatchView batch{
-        Eigen::Map<const Eigen::MatrixXf>(s.data(), obs, B), Eigen::Map<const Eigen::MatrixXf>(a.data(), width, B),
-        Eigen::Map<const Eigen::VectorXf>(r.data(), B),      Eigen::Map<const Eigen::MatrixXf>(s2.data(), obs, B),
-        Eigen::Map<const Eigen::VectorXf>(t.data(), B),      Eigen::Map<const Eigen::VectorXf>(r.data(), B)};
+    Ddpg d(bench::RandomHfoBatch::kObs, space, c, 3);
+    const bench::RandomHfoBatch data(c.batch_size, 4);
+    const BatchView batch = data.view();
     d.update(batch, &batch);  // first-call work (none expected) out of the count
     long allocations = 0;
     {
