@@ -132,6 +132,12 @@ void run_learner(const LearnerCliOptions& o) {
   BestEval best(fs::path(run_dir) / "best_eval.txt", "learner");
 
   RecentEpisodes recent;
+  if (resume) {  // the last-100 training rates go on from the episodes logged before
+    const std::string_view success = env->status_name(env->success_status());
+    for (const LoggedEpisode& e : last_logged_episodes(run_dir, 100)) {
+      recent.add(e.ret, e.steps, e.outcome == success);
+    }
+  }
   UpdateStats last_stats;
   EvalResult last_eval;
   bool have_eval = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <deque>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -177,6 +178,40 @@ void RunLogs::episode(const EpisodeRow& r) {
 void RunLogs::flush() {
   metrics_.flush();
   episodes_.flush();
+}
+
+std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
+  std::ifstream in(dir / "episodes.csv");
+  std::string row;
+  if (n == 0 || !std::getline(in, row)) {
+    return {};
+  }
+  std::deque<LoggedEpisode> last;
+  while (std::getline(in, row)) {
+    // episode, wall_seconds, updates, actor, return, steps, outcome, weights_version
+    std::vector<std::string> f;
+    std::stringstream fields(row);
+    for (std::string x; std::getline(fields, x, ',');) {
+      f.push_back(std::move(x));
+    }
+    if (f.size() != RunLogs::episode_columns().size()) {
+      continue;
+    }
+    LoggedEpisode e;
+    const auto number = [](const std::string& text, auto& value) {
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+      return ec == std::errc() && end == text.data() + text.size();
+    };
+    if (!number(f[4], e.ret) || !number(f[5], e.steps) || !number(f[7], e.weights_version) || f[6].empty()) {
+      continue;
+    }
+    e.outcome = std::move(f[6]);
+    last.push_back(std::move(e));
+    if (last.size() > n) {
+      last.pop_front();
+    }
+  }
+  return {std::make_move_iterator(last.begin()), std::make_move_iterator(last.end())};
 }
 
 BestEval::BestEval(fs::path file, std::string role) : file_(std::move(file)), role_(std::move(role)) {

@@ -90,6 +90,19 @@ class RunLogs {
   std::ofstream episodes_;
 };
 
+// One row of episodes.csv as read back.
+struct LoggedEpisode {
+  double ret = 0.0;
+  int64_t steps = 0;
+  std::string outcome;
+  uint64_t weights_version = 0;
+};
+
+// The last `n` rows of dir/episodes.csv, oldest first (none when there is no file). A resumed
+// run reads them to refill its last-100 training rates, which would otherwise start empty.
+// Rows that do not parse (one cut off by a kill) are skipped.
+std::vector<LoggedEpisode> last_logged_episodes(const std::filesystem::path& dir, size_t n);
+
 // Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
 // success, then a higher return. Persisted in a small text file (the run directory's
 // best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.

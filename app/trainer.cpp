@@ -376,6 +376,17 @@ TrainSummary Trainer::run() {
   logs_.emplace(dir,
                 demo_replay_ ? std::vector<std::string>{"bc_accepted_fraction", "bc_loss"} : std::vector<std::string>{},
                 resume_at);
+  if (o_.resume) {
+    // The last-100 training rates go on from the episodes logged before the checkpoint;
+    // with demonstrations on, weights version 0 marks the scripted offense's, left out as in run().
+    const std::string_view success = env_->status_name(env_->success_status());
+    const bool demos = exploration_.demo_fraction > 0.0;
+    for (const LoggedEpisode& e : last_logged_episodes(dir, 1000)) {
+      if (!(demos && e.weights_version == 0)) {
+        recent_.add(e.ret, e.steps, e.outcome == success);
+      }
+    }
+  }
   best_.emplace(dir / "best_eval.txt");
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);

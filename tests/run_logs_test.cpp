@@ -132,6 +132,34 @@ TEST(RunLogs, AResumedRunDropsTheRowsWrittenAfterItsCheckpoint) {
   fs::remove_all(dir);
 }
 
+TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
+  const fs::path dir = fresh_dir("last");
+  EXPECT_TRUE(last_logged_episodes(dir, 100).empty());  // no file yet
+  {
+    RunLogs logs(dir);
+    for (int64_t episode = 1; episode <= 150; ++episode) {
+      const bool goal = episode % 3 == 0;
+      logs.episode(EpisodeRow{episode, 0.5, episode * 10, 0, goal ? 10.5 : -0.25, episode, goal ? "GOAL" : "OUT_OF_TIME",
+                              static_cast<uint64_t>(episode % 2 == 0 ? 0 : episode * 10)});
+    }
+    logs.flush();
+  }
+  std::ofstream(dir / "episodes.csv", std::ios::app) << "151,0.5,1510,0,1";  // a kill mid-row
+  const std::vector<LoggedEpisode> last = last_logged_episodes(dir, 100);
+  ASSERT_EQ(last.size(), 100U);  // episodes 51-150; the cut-off row is skipped
+  EXPECT_EQ(last.front().steps, 51);
+  EXPECT_EQ(last.back().steps, 150);
+  EXPECT_EQ(last.back().outcome, "GOAL");
+  EXPECT_DOUBLE_EQ(last.back().ret, 10.5);
+  EXPECT_EQ(last.back().weights_version, 0U);
+  EXPECT_EQ(last[98].outcome, "OUT_OF_TIME");
+  EXPECT_DOUBLE_EQ(last[98].ret, -0.25);
+  EXPECT_EQ(last[98].weights_version, 1490U);
+  EXPECT_EQ(last_logged_episodes(dir, 3).size(), 3U);
+  EXPECT_TRUE(last_logged_episodes(dir, 0).empty());
+  fs::remove_all(dir);
+}
+
 TEST(RunLogs, MovesAsideAFileOfAnotherLayout) {
   const fs::path dir = fresh_dir("aside");
   std::ofstream(dir / "metrics.csv") << "wall_seconds,updates,old_column\n1,2,3\n";
