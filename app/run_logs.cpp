@@ -129,7 +129,7 @@ const std::vector<std::string>& RunLogs::metric_columns() {
 
 const std::vector<std::string>& RunLogs::episode_columns() {
   static const std::vector<std::string> columns = {"episode", "wall_seconds", "updates", "actor",
-                                                   "return",  "steps",        "outcome", "weights_version"};
+                                                   "return",  "steps",        "outcome", "weights_version", "policy"};
   return columns;
 }
 
@@ -172,7 +172,8 @@ void RunLogs::metrics(const MetricsRow& r, std::span<const double> extras) {
 
 void RunLogs::episode(const EpisodeRow& r) {
   episodes_ << r.episode << ',' << r.wall_seconds << ',' << r.updates << ',' << r.actor << ',' << r.ret << ','
-            << r.steps << ',' << r.outcome << ',' << r.weights_version << '\n';
+            << r.steps << ',' << r.outcome << ',' << r.weights_version << ',' << (r.scripted ? "scripted" : "agent")
+            << '\n';
 }
 
 void RunLogs::flush() {
@@ -188,7 +189,7 @@ std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
   }
   std::deque<LoggedEpisode> last;
   while (std::getline(in, row)) {
-    // episode, wall_seconds, updates, actor, return, steps, outcome, weights_version
+    // episode, wall_seconds, updates, actor, return, steps, outcome, weights_version, policy
     std::vector<std::string> f;
     std::stringstream fields(row);
     for (std::string x; std::getline(fields, x, ',');) {
@@ -202,9 +203,11 @@ std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
       const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
       return ec == std::errc() && end == text.data() + text.size();
     };
-    if (!number(f[4], e.ret) || !number(f[5], e.steps) || !number(f[7], e.weights_version) || f[6].empty()) {
+    if (!number(f[4], e.ret) || !number(f[5], e.steps) || !number(f[7], e.weights_version) || f[6].empty() ||
+        (f[8] != "agent" && f[8] != "scripted")) {
       continue;
     }
+    e.scripted = f[8] == "scripted";
     e.outcome = std::move(f[6]);
     last.push_back(std::move(e));
     if (last.size() > n) {

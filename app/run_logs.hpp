@@ -7,10 +7,11 @@
 //                 eval_avg_return, then the role's extra columns (the learner's: samples/s,
 //                 shards, actors, weights version, bad messages, time waiting for data).
 //   episodes.csv  one row per episode: episode, wall_seconds, updates, actor, return, steps,
-//                 outcome, weights_version. weights_version 0: no network chose the actions (ε = 1
-//                 before the first weights or update, or a demonstration by the scripted offense,
-//                 exploration.demo_fraction); the training rates (success_rate_100, …) of
-//                 `pamdp train` leave demonstrations out.
+//                 outcome, weights_version, policy. weights_version 0: no network chose the
+//                 actions (ε = 1 before the first weights or update, or a demonstration).
+//                 policy: "agent" (the actor, ε-greedy) or "scripted" (a demonstration by the
+//                 scripted offense, exploration.demo_fraction); the training rates
+//                 (success_rate_100, …) of `pamdp train` leave demonstrations out.
 //
 // "success" is the env's success outcome (GOAL in HFO). Eval columns are empty until the first
 // greedy evaluation. Files are appended to (a resumed run continues them); a file whose header
@@ -60,6 +61,7 @@ struct EpisodeRow {
   int64_t steps = 0;
   std::string_view outcome;
   uint64_t weights_version = 0;
+  bool scripted = false;  // a demonstration: policy "scripted" instead of "agent"
 };
 
 // Where a resumed run continues: its checkpoint's counters.
@@ -96,6 +98,7 @@ struct LoggedEpisode {
   int64_t steps = 0;
   std::string outcome;
   uint64_t weights_version = 0;
+  bool scripted = false;
 };
 
 // The last `n` rows of dir/episodes.csv, oldest first (none when there is no file). A resumed

@@ -377,12 +377,11 @@ TrainSummary Trainer::run() {
                 demo_replay_ ? std::vector<std::string>{"bc_accepted_fraction", "bc_loss"} : std::vector<std::string>{},
                 resume_at);
   if (o_.resume) {
-    // The last-100 training rates go on from the episodes logged before the checkpoint;
-    // with demonstrations on, weights version 0 marks the scripted offense's, left out as in run().
+    // The last-100 training rates go on from the episodes logged before the checkpoint, the
+    // scripted offense's left out as in run().
     const std::string_view success = env_->status_name(env_->success_status());
-    const bool demos = exploration_.demo_fraction > 0.0;
     for (const LoggedEpisode& e : last_logged_episodes(dir, 1000)) {
-      if (!(demos && e.weights_version == 0)) {
+      if (!e.scripted) {
         recent_.add(e.ret, e.steps, e.outcome == success);
       }
     }
@@ -470,8 +469,9 @@ TrainSummary Trainer::run() {
     ep.ret = ep_return;
     ep.steps = steps;
     ep.outcome = env_->status_name(sr.status);
-    // One process: always the newest weights; 0 marks an episode the scripted offense played.
+    // One process: always the newest weights; none (0) for an episode the scripted offense played.
     ep.weights_version = demo ? 0 : static_cast<uint64_t>(ddpg_.updates());
+    ep.scripted = demo;
     logs_->episode(ep);
     if (bar_) {
       bar_->update(ddpg_.updates());

@@ -426,6 +426,7 @@ struct EpisodeCsvRow {
   int64_t steps = 0;
   std::string outcome;
   std::string weights_version;
+  std::string policy;
 };
 
 std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
@@ -440,8 +441,8 @@ std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
     while (std::getline(ss, col, ',')) {
       cols.push_back(col);
     }
-    if (cols.size() == 8) {
-      rows.push_back({std::stoll(cols[2]), std::stoll(cols[5]), cols[6], cols[7]});
+    if (cols.size() == 9) {
+      rows.push_back({std::stoll(cols[2]), std::stoll(cols[5]), cols[6], cols[7], cols[8]});
     }
   }
   return rows;
@@ -459,7 +460,7 @@ app::ExperimentConfig hfo_demo_config(double demo_fraction, int64_t episodes) {
 
 TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
   // All demonstrations: the scripted offense scores ~.998 on the empty goal; every episode is
-  // marked with weights_version 0, also after the updates began.
+  // marked policy "scripted" with weights_version 0, also after the updates began.
   const fs::path dir = fresh_dir("demo");
   app::train(hfo_demo_config(1.0, 30), {dir.string(), false, true, nullptr});
   const auto rows = episode_rows(dir / "episodes.csv");
@@ -468,6 +469,7 @@ TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
   int goals = 0;
   for (const auto& r : rows) {
     EXPECT_EQ(r.weights_version, "0");
+    EXPECT_EQ(r.policy, "scripted");
     goals += r.outcome == "GOAL" ? 1 : 0;
   }
   EXPECT_GE(goals, 27);
@@ -510,7 +512,10 @@ TEST(Train, DemonstrationsArePlayedByTheScriptedOffense) {
   app::train(hfo_demo_config(0.0, 30), {none.string(), false, true, nullptr});
   goals = 0;
   int64_t acted = 0;
-  for (const auto& r : episode_rows(none / "episodes.csv")) {
+  const auto agent_rows = episode_rows(none / "episodes.csv");
+  ASSERT_EQ(agent_rows.size(), 30U);
+  for (const auto& r : agent_rows) {
+    EXPECT_EQ(r.policy, "agent");
     goals += r.outcome == "GOAL" ? 1 : 0;
     if (r.updates > 0) {
       ++acted;
@@ -532,21 +537,18 @@ TEST(Train, CloningIsLoggedAndItsDemonstrationsSurviveAResume) {
   ASSERT_TRUE(fs::exists(dir / "demo_replay.bin"));
   const hfo::HfoEnv env;
   const int width = env.action_space().output_width();
-  // Demonstrations are the episodes with weights_version 0 once updates run; the episodes
-  // before the first update carry 0 whoever played them.
+  // Every step of the episodes marked "scripted" is a demonstration kept, and nothing else.
   auto expect_every_demonstrated_step = [&](const char* when) {
     ReplayBuffer demos(c.replay.capacity, env.observation_size(), width);
     load_replay_snapshot((dir / "demo_replay.bin").string(), demos);
-    int64_t known = 0;
-    int64_t unsure = 0;
+    int64_t demonstrated = 0;
+    int64_t agent = 0;
     for (const auto& r : episode_rows(dir / "episodes.csv")) {
-      if (r.weights_version == "0") {
-        (r.updates > 0 ? known : unsure) += r.steps;
-      }
+      (r.policy == "scripted" ? demonstrated : agent) += r.steps;
     }
-    EXPECT_GT(known, 0);
-    EXPECT_GE(demos.size(), known) << when;
-    EXPECT_LE(demos.size(), known + unsure) << when;
+    EXPECT_GT(demonstrated, 0);
+    EXPECT_GT(agent, 0);
+    EXPECT_EQ(demos.size(), demonstrated) << when;
   };
   expect_every_demonstrated_step("after the first run");
 

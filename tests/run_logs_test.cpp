@@ -59,6 +59,7 @@ TEST(RunLogs, WritesHeadersOnceAndRowsInColumnOrder) {
     logs.metrics(row, extras);
     EpisodeRow ep{7, 1.25, 90, 3, 1.5, 55, "GOAL", 42};
     logs.episode(ep);
+    logs.episode(EpisodeRow{8, 2.5, 95, 0, 10.0, 60, "GOAL", 0, /*scripted=*/true});
     logs.flush();
   }
   {
@@ -81,9 +82,10 @@ TEST(RunLogs, WritesHeadersOnceAndRowsInColumnOrder) {
   EXPECT_EQ(m[1], "1.5,100,120,3,0.5,0.25,2,40,0.125,0.75,10,12,,,,2");
   EXPECT_EQ(m[2], "0,0,0,0,,0,0,0,0,0,0,0,0.5,70,3,1");  // no epsilon: an empty cell
   const auto e = lines_of(dir / "episodes.csv");
-  ASSERT_EQ(e.size(), 2U);
-  EXPECT_EQ(e[0], "episode,wall_seconds,updates,actor,return,steps,outcome,weights_version");
-  EXPECT_EQ(e[1], "7,1.25,90,3,1.5,55,GOAL,42");
+  ASSERT_EQ(e.size(), 3U);
+  EXPECT_EQ(e[0], "episode,wall_seconds,updates,actor,return,steps,outcome,weights_version,policy");
+  EXPECT_EQ(e[1], "7,1.25,90,3,1.5,55,GOAL,42,agent");
+  EXPECT_EQ(e[2], "8,2.5,95,0,10,60,GOAL,0,scripted");
   fs::remove_all(dir);
 }
 
@@ -123,7 +125,7 @@ TEST(RunLogs, AResumedRunDropsTheRowsWrittenAfterItsCheckpoint) {
   for (size_t i = 1; i < e.size(); ++i) {
     EXPECT_EQ(e[i].substr(0, 2), std::to_string(i) + ",") << e[i];
   }
-  EXPECT_EQ(e[4], "4,0.5,40,0,1,20,GOAL,0");
+  EXPECT_EQ(e[4], "4,0.5,40,0,1,20,GOAL,0,agent");
 
   {
     RunLogs plain(dir);  // without a resume point nothing is dropped
@@ -139,8 +141,9 @@ TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
     RunLogs logs(dir);
     for (int64_t episode = 1; episode <= 150; ++episode) {
       const bool goal = episode % 3 == 0;
+      const bool scripted = episode % 2 == 0;
       logs.episode(EpisodeRow{episode, 0.5, episode * 10, 0, goal ? 10.5 : -0.25, episode, goal ? "GOAL" : "OUT_OF_TIME",
-                              static_cast<uint64_t>(episode % 2 == 0 ? 0 : episode * 10)});
+                              static_cast<uint64_t>(scripted ? 0 : episode * 10), scripted});
     }
     logs.flush();
   }
@@ -152,6 +155,8 @@ TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
   EXPECT_EQ(last.back().outcome, "GOAL");
   EXPECT_DOUBLE_EQ(last.back().ret, 10.5);
   EXPECT_EQ(last.back().weights_version, 0U);
+  EXPECT_TRUE(last.back().scripted);
+  EXPECT_FALSE(last[98].scripted);
   EXPECT_EQ(last[98].outcome, "OUT_OF_TIME");
   EXPECT_DOUBLE_EQ(last[98].ret, -0.25);
   EXPECT_EQ(last[98].weights_version, 1490U);
