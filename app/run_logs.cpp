@@ -128,8 +128,8 @@ const std::vector<std::string>& RunLogs::metric_columns() {
 }
 
 const std::vector<std::string>& RunLogs::episode_columns() {
-  static const std::vector<std::string> columns = {"episode", "wall_seconds", "updates", "actor",
-                                                   "return",  "steps",        "outcome", "weights_version", "policy"};
+  static const std::vector<std::string> columns = {"episode", "wall_seconds", "updates",         "actor", "return",
+                                                   "steps",   "outcome",      "weights_version", "policy"};
   return columns;
 }
 

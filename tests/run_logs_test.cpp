@@ -142,8 +142,9 @@ TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
     for (int64_t episode = 1; episode <= 150; ++episode) {
       const bool goal = episode % 3 == 0;
       const bool scripted = episode % 2 == 0;
-      logs.episode(EpisodeRow{episode, 0.5, episode * 10, 0, goal ? 10.5 : -0.25, episode, goal ? "GOAL" : "OUT_OF_TIME",
-                              static_cast<uint64_t>(scripted ? 0 : episode * 10), scripted});
+      logs.episode(EpisodeRow{episode, 0.5, episode * 10, 0, goal ? 10.5 : -0.25, episode,
+                              goal ? "GOAL" : "OUT_OF_TIME", static_cast<uint64_t>(scripted ? 0 : episode * 10),
+                              scripted});
     }
     logs.flush();
   }
