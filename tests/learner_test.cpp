@@ -429,18 +429,23 @@ struct EpisodeCsvRow {
   std::string policy;
 };
 
+// The fields of one CSV line of a run directory (no quoting there).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  for (std::string f; std::getline(ss, f, ',');) {
+    fields.push_back(f);
+  }
+  return fields;
+}
+
 std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);  // header
   std::vector<EpisodeCsvRow> rows;
   while (std::getline(in, line)) {
-    std::vector<std::string> cols;
-    std::stringstream ss(line);
-    std::string col;
-    while (std::getline(ss, col, ',')) {
-      cols.push_back(col);
-    }
+    const std::vector<std::string> cols = csv_fields(line);
     if (cols.size() == 9) {
       rows.push_back({std::stoll(cols[2]), std::stoll(cols[5]), cols[6], cols[7], cols[8]});
     }
@@ -588,13 +593,9 @@ TEST(Train, ResumeIsBitForBit) {
     std::ifstream in(dir / "metrics.csv");
     std::map<std::string, std::vector<std::string>> rows;
     for (std::string line; std::getline(in, line);) {
-      std::vector<std::string> fields;
-      std::stringstream ss(line);
-      for (std::string f; std::getline(ss, f, ',');) {
-        fields.push_back(f);
-      }
+      std::vector<std::string> fields = csv_fields(line);
       if (fields.size() > 7) {
-        rows[fields[1]] = fields;
+        rows[fields[1]] = std::move(fields);
       }
     }
     return rows;
