@@ -127,8 +127,16 @@ void run_learner(const LearnerCliOptions& o) {
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);
 
-  RunLogs logs(run_dir, {"samples_per_s", "shards", "actors_joined", "weights_version", "malformed_messages",
-                         "waiting_for_data_ms"});
+  // Resumed: the metrics rows past the checkpoint go (the resumed learner redoes those updates and
+  // logs them again); the episode rows stay (see below).
+  std::optional<ResumePoint> resume_at;
+  if (resume) {
+    resume_at = ResumePoint{static_cast<int64_t>(ddpg.updates()), std::nullopt};
+  }
+  RunLogs logs(
+      run_dir,
+      {"samples_per_s", "shards", "actors_joined", "weights_version", "malformed_messages", "waiting_for_data_ms"},
+      resume_at);
   BestEval best(fs::path(run_dir) / "best_eval.txt", "learner");
 
   RecentEpisodes recent;
@@ -152,6 +160,22 @@ void run_learner(const LearnerCliOptions& o) {
   double last_tick = elapsed();
   int64_t episode_count = meta.episodes;
   int64_t env_steps = meta.env_steps;  // steps of the episodes reported so far
+  if (resume) {
+    // Episodes the actors reported after the last checkpoint were played, and their transitions
+    // are in the replay shards: count them, and number the next episodes after them.
+    int64_t after = 0;
+    for_each_logged_episode(run_dir, [&](const LoggedEpisode& e) {
+      if (e.episode > episode_count) {
+        episode_count = e.episode;
+        env_steps += e.steps;
+        ++after;
+      }
+    });
+    if (after > 0) {
+      log::info("learner: {} episodes logged after the checkpoint are kept; episodes go on from {}", after,
+                episode_count + 1);
+    }
+  }
   int64_t last_env_steps = env_steps;
   double last_print = -1e9;
 

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdio>
 #include <deque>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -141,8 +142,9 @@ RunLogs::RunLogs(const fs::path& dir, std::vector<std::string> extra_metric_colu
   std::optional<KeepUpTo> metrics_keep;
   std::optional<KeepUpTo> episodes_keep;
   if (resume_at) {
-    metrics_keep = KeepUpTo{1, resume_at->updates};    // the "updates" column
-    episodes_keep = KeepUpTo{0, resume_at->episodes};  // the "episode" column
+    metrics_keep = KeepUpTo{1, resume_at->updates};  // the "updates" column
+    // The "episode" column; without a limit only a row cut off by the kill goes.
+    episodes_keep = KeepUpTo{0, resume_at->episodes.value_or(std::numeric_limits<int64_t>::max())};
   }
   metrics_ = open_csv(dir / "metrics.csv", join(columns), metrics_keep);
   episodes_ = open_csv(dir / "episodes.csv", join(episode_columns()), episodes_keep);
@@ -181,16 +183,17 @@ void RunLogs::flush() {
   episodes_.flush();
 }
 
-std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
+void for_each_logged_episode(const fs::path& dir, const std::function<void(const LoggedEpisode&)>& visit) {
   std::ifstream in(dir / "episodes.csv");
   std::string row;
-  if (n == 0 || !std::getline(in, row)) {
-    return {};
+  if (!std::getline(in, row)) {
+    return;
   }
-  std::deque<LoggedEpisode> last;
+  std::vector<std::string> f;
+  LoggedEpisode e;
   while (std::getline(in, row)) {
     // episode, wall_seconds, updates, actor, return, steps, outcome, weights_version, policy
-    std::vector<std::string> f;
+    f.clear();
     std::stringstream fields(row);
     for (std::string x; std::getline(fields, x, ',');) {
       f.push_back(std::move(x));
@@ -198,22 +201,31 @@ std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
     if (f.size() != RunLogs::episode_columns().size()) {
       continue;
     }
-    LoggedEpisode e;
     const auto number = [](const std::string& text, auto& value) {
       const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
       return ec == std::errc() && end == text.data() + text.size();
     };
-    if (!number(f[4], e.ret) || !number(f[5], e.steps) || !number(f[7], e.weights_version) || f[6].empty() ||
-        (f[8] != "agent" && f[8] != "scripted")) {
+    if (!number(f[0], e.episode) || !number(f[4], e.ret) || !number(f[5], e.steps) ||
+        !number(f[7], e.weights_version) || f[6].empty() || (f[8] != "agent" && f[8] != "scripted")) {
       continue;
     }
     e.scripted = f[8] == "scripted";
     e.outcome = std::move(f[6]);
-    last.push_back(std::move(e));
+    visit(e);
+  }
+}
+
+std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
+  std::deque<LoggedEpisode> last;
+  if (n == 0) {
+    return {};
+  }
+  for_each_logged_episode(dir, [&](const LoggedEpisode& e) {
+    last.push_back(e);
     if (last.size() > n) {
       last.pop_front();
     }
-  }
+  });
   return {std::make_move_iterator(last.begin()), std::make_move_iterator(last.end())};
 }
 

@@ -17,7 +17,9 @@
 // greedy evaluation. Files are appended to (a resumed run continues them); a file whose header
 // is not this format (a run from an older version) is renamed to NAME.old-format and restarted.
 // A resumed `pamdp train` run first drops the rows its killed predecessor wrote after the last
-// checkpoint: it replays that stretch bit for bit and writes those rows again.
+// checkpoint: it replays that stretch bit for bit and writes those rows again. A resumed
+// `pamdp learner` drops the metrics rows past its checkpoint (it redoes those updates) and keeps
+// the episode rows, numbering its next episodes after them.
 // Rows are flushed at every metrics row so a killed run keeps its log up to the last one.
 // Not thread-safe; cost: one formatted line per call.
 #pragma once
@@ -64,10 +66,12 @@ struct EpisodeRow {
   bool scripted = false;  // a demonstration: policy "scripted" instead of "agent"
 };
 
-// Where a resumed run continues: its checkpoint's counters.
+// Where a resumed run continues: its checkpoint's counters. Without `episodes`, every whole episode row
+// is kept: `pamdp learner` logs episodes its actors played, which stay real (their transitions
+// are in the replay shards) when the learner is killed before its next checkpoint.
 struct ResumePoint {
   int64_t updates = 0;
-  int64_t episodes = 0;
+  std::optional<int64_t> episodes;
 };
 
 class RunLogs {
@@ -94,6 +98,7 @@ class RunLogs {
 
 // One row of episodes.csv as read back.
 struct LoggedEpisode {
+  int64_t episode = 0;
   double ret = 0.0;
   int64_t steps = 0;
   std::string outcome;
@@ -105,6 +110,9 @@ struct LoggedEpisode {
 // run reads them to refill its last-100 training rates, which would otherwise start empty.
 // Rows that do not parse (one cut off by a kill) are skipped.
 std::vector<LoggedEpisode> last_logged_episodes(const std::filesystem::path& dir, size_t n);
+// Calls `visit` with every row of dir/episodes.csv that parses, in file order, holding one row at
+// a time (a long run's file has millions).
+void for_each_logged_episode(const std::filesystem::path& dir, const std::function<void(const LoggedEpisode&)>& visit);
 
 // Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
 // success, then a higher return. Persisted in a small text file (the run directory's

@@ -134,6 +134,31 @@ TEST(RunLogs, AResumedRunDropsTheRowsWrittenAfterItsCheckpoint) {
   fs::remove_all(dir);
 }
 
+// `pamdp learner --resume`: the updates after the checkpoint are redone, the episodes the actors
+// played meanwhile are not, so only metrics rows go.
+TEST(RunLogs, AResumeWithoutAnEpisodeCountKeepsEveryEpisodeRow) {
+  const fs::path dir = fresh_dir("resume-learner");
+  {
+    RunLogs logs(dir);
+    for (const int64_t updates : {100, 200, 300}) {
+      MetricsRow row;
+      row.updates = updates;
+      logs.metrics(row);
+    }
+    for (int64_t episode = 1; episode <= 5; ++episode) {
+      logs.episode(EpisodeRow{episode, 0.5, episode * 60, 0, 1.0, 20, "GOAL", 1});
+    }
+  }
+  std::ofstream(dir / "episodes.csv", std::ios::app) << "6,0.5,3";  // a kill mid-row
+  { RunLogs resumed(dir, {}, ResumePoint{150, std::nullopt}); }
+  EXPECT_EQ(lines_of(dir / "metrics.csv").size(), 2U);  // header, 100
+  EXPECT_EQ(lines_of(dir / "episodes.csv").size(), 6U);
+  std::vector<int64_t> numbers;
+  for_each_logged_episode(dir, [&](const LoggedEpisode& e) { numbers.push_back(e.episode); });
+  EXPECT_EQ(numbers, (std::vector<int64_t>{1, 2, 3, 4, 5}));
+  fs::remove_all(dir);
+}
+
 TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
   const fs::path dir = fresh_dir("last");
   EXPECT_TRUE(last_logged_episodes(dir, 100).empty());  // no file yet
@@ -152,6 +177,7 @@ TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
   const std::vector<LoggedEpisode> last = last_logged_episodes(dir, 100);
   ASSERT_EQ(last.size(), 100U);  // episodes 51-150; the cut-off row is skipped
   EXPECT_EQ(last.front().steps, 51);
+  EXPECT_EQ(last.front().episode, 51);
   EXPECT_EQ(last.back().steps, 150);
   EXPECT_EQ(last.back().outcome, "GOAL");
   EXPECT_DOUBLE_EQ(last.back().ret, 10.5);

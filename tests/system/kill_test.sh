@@ -78,6 +78,20 @@ echo "shard: kill -9 with $size_before transitions (snapshot $snapshot_bytes byt
 # --- learner: kill -9, --resume on the same ports ----------------------------------------------
 wait_for 20 "no checkpoint" '[[ -s $work/run/checkpoint.ckpt ]]'
 actor1_version=$(metric "${aurl[1]}" pamdp_actor_weights_version)
+# Kill it when metrics.csv has a row past the checkpoint (it logs every 0.5 s and checkpoints
+# every 1 s), so that the resumed learner finds rows its predecessor wrote after the checkpoint.
+# A checkpoint written between the look and the kill only makes the check below weaker.
+for _ in $(seq 40); do
+  cp "$work/run/checkpoint.ckpt" "$work/probe.ckpt"
+  (cd "$work" && flatc --json --strict-json --raw-binary "$src/schemas/checkpoint.fbs" -- probe.ckpt)
+  probe_updates=$(grep -o '"updates": *[0-9]*' "$work/probe.json" | grep -o '[0-9]*$' || echo 0)
+  last_row_updates=$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f2)
+  if [[ $last_row_updates =~ ^[0-9]+$ ]] && ((last_row_updates > probe_updates)) &&
+    cmp -s "$work/run/checkpoint.ckpt" "$work/probe.ckpt"; then
+    break
+  fi
+  sleep 0.05
+done
 kill -KILL "${pid[learner]}"
 wait "${pid[learner]}" 2>/dev/null || true
 faults=$((faults + 1))
@@ -114,6 +128,13 @@ column() {
 wait_for 10 "metrics.csv has no row from the resumed learner" 'ge "$(column updates)" "$first"'
 csv_episodes=$(column episodes)
 ge "$csv_episodes" "$ck_episodes" || fail "episodes $csv_episodes after resume, the checkpoint had $ck_episodes"
+# The updates after the checkpoint are redone and logged once: metrics.csv's updates never go
+# back. The episodes the actors played meanwhile stay logged, and the resumed learner numbers its
+# episodes after them: episodes.csv counts 1, 2, 3, ... with no number twice.
+updates_back=$(awk -F, 'NR > 2 && $2 < prev { print NR ": " prev " -> " $2; exit } NR > 1 { prev = $2 }' "$work/run/metrics.csv")
+[[ -z $updates_back ]] || fail "metrics.csv's updates go back after the resume (line $updates_back)"
+episodes_off=$(awk -F, 'NR > 1 && $1 != NR - 1 { print NR ": episode " $1; exit }' "$work/run/episodes.csv")
+[[ -z $episodes_off ]] || fail "episodes.csv is not numbered 1, 2, 3, ... after the resume (line $episodes_off)"
 echo "learner: kill -9 at checkpoint updates $ck_updates, episodes $ck_episodes, weights v$ck_version -> resumed at $first updates, episodes $csv_episodes, same 2 shards + 2 actors back (actor 1 weights v$actor1_version -> v$(metric "${aurl[1]}" pamdp_actor_weights_version)), updates now $(updates) at $(since)"
 
 # --- SIGTERM: a resumable run directory ---------------------------------------------------------
