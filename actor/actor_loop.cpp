@@ -36,11 +36,6 @@ int64_t ms_between(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration_cast<std::chrono::milliseconds>(to - from).count();
 }
 
-uint64_t mix(uint64_t a, uint64_t b) {
-  Rng r(a ^ (b * 0x9E3779B97F4A7C15ULL));
-  return r.next_u64();
-}
-
 size_t area(int rows, int width) {
   return static_cast<size_t>(rows) * static_cast<size_t>(width);
 }
@@ -290,16 +285,17 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
       bounds(OutputBounds::for_actor(env_list.front()->action_space())),
       actor_index(map.actor_index),
       sub(ctx, net::SocketType::kSub),
-      explore(env_list.front()->action_space(), config.exploration, mix(config.seed, 1000 + uint64_t{map.actor_index})),
+      explore(env_list.front()->action_space(), config.exploration,
+              mix_seeds(config.seed, 1000 + uint64_t{map.actor_index})),
       input(obs_dim, 1),
       net_out(static_cast<size_t>(width)),
       batch(config.batch_transitions, obs_dim, width),
       batch_fbb(static_cast<size_t>(config.batch_transitions) * (2 * area(1, obs_dim) + area(1, width) + 3) * 4 +
                 1024) {
-  const uint64_t actor_seed = mix(config.seed, 2000 + uint64_t{actor_index});
+  const uint64_t actor_seed = mix_seeds(config.seed, 2000 + uint64_t{actor_index});
   envs.reserve(env_list.size());
   for (size_t k = 0; k < env_list.size(); ++k) {
-    envs.emplace_back(std::move(env_list[k]), obs_dim, width, mix(actor_seed, k));
+    envs.emplace_back(std::move(env_list[k]), obs_dim, width, mix_seeds(actor_seed, k));
   }
   sub.set_max_message_bytes(kMaxWeightsBytes);
   sub.set_recv_hwm(4);  // only the newest weights matter
@@ -348,7 +344,7 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
 }
 
 void ActorLoop::Impl::reset(EnvSlot& slot) {
-  slot.env->reset(mix(slot.seed, slot.episodes), slot.obs);
+  slot.env->reset(mix_seeds(slot.seed, slot.episodes), slot.obs);
   slot.episode.clear();
   slot.ret = 0.0;
   slot.steps = 0;

@@ -216,15 +216,13 @@ void run_learner(const LearnerCliOptions& o) {
     if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
       backend->sync_actor_to_host();
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration);
-      last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, c.seed + static_cast<uint64_t>(ddpg.updates()));
+      last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, screening_seed(c.seed, ddpg.updates()));
       have_eval = true;
       learner_metrics.on_eval(last_eval);
       std::function<EvalResult()> confirm;
       if (c.train.confirm_episodes > 0) {
         confirm = [&] {
-          // Other starts than every screening evaluation's (seeds c.seed + updates).
-          return evaluate(*eval_env, policy, c.train.confirm_episodes,
-                          c.seed + static_cast<uint64_t>(ddpg.updates()) + (uint64_t{1} << 40));
+          return evaluate(*eval_env, policy, c.train.confirm_episodes, confirmation_seed(c.seed, ddpg.updates()));
         };
       }
       if (best.offer(last_eval, ddpg.updates(), confirm)) {

@@ -33,11 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-uint64_t mix(uint64_t a, uint64_t b) {
-  Rng r(a ^ (b * 0x9E3779B97F4A7C15ULL));
-  return r.next_u64();
-}
-
 // Transitions of the running episode, kept until it ends so that Monte-Carlo returns can be
 // computed before insertion. Sized once for the env's longest episode.
 class EpisodeBuffer {
@@ -102,11 +97,11 @@ class Trainer {
         exploration_(resolve_exploration(c, space_)),
         obs_dim_(env_->observation_size()),
         width_(space_.output_width()),
-        ddpg_(obs_dim_, space_, c.ddpg, mix(c.seed, 1)),
+        ddpg_(obs_dim_, space_, c.ddpg, mix_seeds(c.seed, 1)),
         backend_(make_update_backend(ddpg_, c.ddpg.device)),
         replay_(c.replay.capacity, obs_dim_, width_),
-        explore_(space_, exploration_, mix(c.seed, 2)),
-        sample_rng_(mix(c.seed, 3)),
+        explore_(space_, exploration_, mix_seeds(c.seed, 2)),
+        sample_rng_(mix_seeds(c.seed, 3)),
         batch_(obs_dim_, width_, c.ddpg.batch_size),
         episode_(env_->max_episode_steps(), obs_dim_, width_),
         obs_(static_cast<size_t>(obs_dim_)),
@@ -242,7 +237,7 @@ void Trainer::run_eval() {
   }
   backend_->sync_actor_to_host();
   GreedyActorPolicy policy(ddpg_, space_, exploration_);
-  last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, mix(c_.seed, 1000 + ddpg_.updates()));
+  last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, screening_seed(c_.seed, ddpg_.updates()));
   have_eval_ = true;
   if (o_.metrics != nullptr) {
     o_.metrics->on_eval(last_eval_);
@@ -253,7 +248,7 @@ void Trainer::run_eval() {
   std::function<EvalResult()> confirm;
   if (c_.train.confirm_episodes > 0) {
     confirm = [&] {
-      return evaluate(*eval_env_, policy, c_.train.confirm_episodes, mix(mix(c_.seed, 1000 + ddpg_.updates()), 1));
+      return evaluate(*eval_env_, policy, c_.train.confirm_episodes, confirmation_seed(c_.seed, ddpg_.updates()));
     };
   }
   if (best_->offer(last_eval_, ddpg_.updates(), confirm)) {
@@ -400,7 +395,7 @@ TrainSummary Trainer::run() {
 
   while (!should_stop()) {
     // One episode.
-    env_->reset(mix(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
+    env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
     episode_.clear();
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
     const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);

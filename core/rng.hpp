@@ -61,4 +61,11 @@ class Rng {
   std::array<uint64_t, 4> state_{};
 };
 
+// A seed derived from two: for the streams of a run (its seed and a purpose or a counter), so
+// that neighbouring seeds do not give overlapping streams.
+inline uint64_t mix_seeds(uint64_t a, uint64_t b) {
+  Rng r(a ^ (b * 0x9E3779B97F4A7C15ULL));
+  return r.next_u64();
+}
+
 }  // namespace pamdp

@@ -6,7 +6,17 @@
 #include <string>
 #include <vector>
 
+#include "core/rng.hpp"
+
 namespace pamdp {
+
+uint64_t screening_seed(uint64_t run_seed, int64_t updates) {
+  return mix_seeds(run_seed, 1000 + static_cast<uint64_t>(updates));
+}
+
+uint64_t confirmation_seed(uint64_t run_seed, int64_t updates) {
+  return mix_seeds(screening_seed(run_seed, updates), 1);
+}
 
 EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const std::function<void(int)>& on_episode,
                     const std::function<void(const EvalStep&)>& on_step) {

@@ -40,6 +40,12 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed,
                     const std::function<void(int)>& on_episode = {},
                     const std::function<void(const EvalStep&)>& on_step = {});
 
+// The starts of a run's greedy evaluation after `updates` updates (train.eval_episodes), and the
+// other starts its confirmation plays (train.confirm_episodes). `pamdp train` and `pamdp learner`
+// both use these, so a run's seed picks the same starts whichever of them trains it.
+uint64_t screening_seed(uint64_t run_seed, int64_t updates);
+uint64_t confirmation_seed(uint64_t run_seed, int64_t updates);
+
 // One JSON object (no newline) with keys episodes, goal_rate, avg_steps_to_goal, avg_return,
 // avg_steps, outcomes.
 std::string to_json(const EvalResult& r);

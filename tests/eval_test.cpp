@@ -205,5 +205,20 @@ TEST(ToJson, ParsesBackWithEveryKeyAndValue) {
   EXPECT_EQ(outcomes, r.outcomes);
 }
 
+// A run's screens and confirmations play starts no other evaluation of the run plays: the
+// confirmation is an independent second opinion only if its starts are not the screen's.
+TEST(EvaluationSeeds, ScreensAndConfirmationsOfARunNeverShareStarts) {
+  std::vector<uint64_t> seeds;
+  for (const uint64_t run : {1U, 2U}) {
+    for (int64_t updates = 0; updates <= 200000; updates += 10000) {
+      seeds.push_back(screening_seed(run, updates));
+      seeds.push_back(confirmation_seed(run, updates));
+    }
+  }
+  std::sort(seeds.begin(), seeds.end());
+  EXPECT_EQ(std::adjacent_find(seeds.begin(), seeds.end()), seeds.end());
+  EXPECT_EQ(screening_seed(7, 30000), screening_seed(7, 30000));  // a function of its arguments only
+}
+
 }  // namespace
 }  // namespace pamdp
