@@ -140,10 +140,25 @@ void run_learner(const LearnerCliOptions& o) {
   BestEval best(fs::path(run_dir) / "best_eval.txt", "learner");
 
   RecentEpisodes recent;
-  if (resume) {  // the last-100 training rates go on from the episodes logged before
+  int64_t episode_count = meta.episodes;
+  int64_t env_steps = meta.env_steps;  // steps of the episodes reported so far
+  if (resume) {
+    // One pass over episodes.csv. The last-100 training rates go on from the episodes logged
+    // before. The episodes the actors reported after the last checkpoint were played, and their
+    // transitions are in the replay shards: count them, and number the next episodes after them.
     const std::string_view success = env->status_name(env->success_status());
-    for (const LoggedEpisode& e : last_logged_episodes(run_dir, 100)) {
+    int64_t after = 0;
+    for_each_logged_episode(run_dir, [&](const LoggedEpisode& e) {
       recent.add(e.ret, e.steps, e.outcome == success);
+      if (e.episode > episode_count) {
+        episode_count = e.episode;
+        env_steps += e.steps;
+        ++after;
+      }
+    });
+    if (after > 0) {
+      log::info("learner: {} episodes logged after the checkpoint are kept; episodes go on from {}", after,
+                episode_count + 1);
     }
   }
   UpdateStats last_stats;
@@ -158,24 +173,6 @@ void run_learner(const LearnerCliOptions& o) {
   int64_t last_updates = ddpg.updates();
   int64_t last_samples = 0;
   double last_tick = elapsed();
-  int64_t episode_count = meta.episodes;
-  int64_t env_steps = meta.env_steps;  // steps of the episodes reported so far
-  if (resume) {
-    // Episodes the actors reported after the last checkpoint were played, and their transitions
-    // are in the replay shards: count them, and number the next episodes after them.
-    int64_t after = 0;
-    for_each_logged_episode(run_dir, [&](const LoggedEpisode& e) {
-      if (e.episode > episode_count) {
-        episode_count = e.episode;
-        env_steps += e.steps;
-        ++after;
-      }
-    });
-    if (after > 0) {
-      log::info("learner: {} episodes logged after the checkpoint are kept; episodes go on from {}", after,
-                episode_count + 1);
-    }
-  }
   int64_t last_env_steps = env_steps;
   double last_print = -1e9;
 

@@ -216,10 +216,10 @@ void for_each_logged_episode(const fs::path& dir, const std::function<void(const
 }
 
 std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
-  std::deque<LoggedEpisode> last;
   if (n == 0) {
     return {};
   }
+  std::deque<LoggedEpisode> last;
   for_each_logged_episode(dir, [&](const LoggedEpisode& e) {
     last.push_back(e);
     if (last.size() > n) {

@@ -66,9 +66,9 @@ struct EpisodeRow {
   bool scripted = false;  // a demonstration: policy "scripted" instead of "agent"
 };
 
-// Where a resumed run continues: its checkpoint's counters. Without `episodes`, every whole episode row
-// is kept: `pamdp learner` logs episodes its actors played, which stay real (their transitions
-// are in the replay shards) when the learner is killed before its next checkpoint.
+// Where a resumed run continues: its checkpoint's counters. Without `episodes`, every whole
+// episode row is kept: `pamdp learner` logs episodes its actors played, which stay real (their
+// transitions are in the replay shards) when the learner is killed before its next checkpoint.
 struct ResumePoint {
   int64_t updates = 0;
   std::optional<int64_t> episodes;
