@@ -31,6 +31,9 @@ namespace {
 }
 
 #ifdef PAMDP_HAVE_OPENBLAS
+// Row block of the a * b products OpenBLAS runs; see gemm().
+constexpr Eigen::Index kBlasRowBlock = 16;
+
 // Every process here runs its own threads (actors, a learner, shards); a BLAS that starts one
 // worker per core under each of them would oversubscribe the cores and make results depend on
 // the split. One thread per call, set once before the first product.
@@ -49,16 +52,16 @@ void blas_gemm(char ta, char tb, int m, int n, int k, const Scalar* a, int lda, 
     dgemm_(&ta, &tb, &m, &n, &k, &one, a, &lda, b, &ldb, &beta, c, &ldc);
   }
 }
-#else
-template <typename Lhs, typename Rhs, typename Scalar>
-void eigen_gemm(const Lhs& a, const Rhs& b, MatrixRef<Scalar>& c, bool accumulate) {
+#endif
+
+template <typename Lhs, typename Rhs, typename Out>
+void eigen_gemm(const Lhs& a, const Rhs& b, Out&& c, bool accumulate) {
   if (accumulate) {
     c.noalias() += a * b;
   } else {
     c.noalias() = a * b;
   }
 }
-#endif
 
 }  // namespace
 
@@ -87,8 +90,21 @@ void gemm(Op op_a, const ConstMatrixRef<Scalar>& a, Op op_b, const ConstMatrixRe
   }
   // BLAS wants leading dimensions >= 1 even for one-row operands.
   const auto ld = [](const auto& x) { return static_cast<int>(std::max<Eigen::Index>(1, x.outerStride())); };
-  blas_gemm<Scalar>(ta ? 'T' : 'N', tb ? 'T' : 'N', static_cast<int>(m), static_cast<int>(n), static_cast<int>(k),
-                    a.data(), ld(a), b.data(), ld(b), accumulate ? Scalar(1) : Scalar(0), c.data(), ld(c));
+  // OpenBLAS 0.3.21's AVX-512 kernels (SkylakeX and newer cores) call malloc on every a * b
+  // (no transpose) whose row count ends 1 to 8 rows past a multiple of 16 (float; 1 to 4 past
+  // a multiple of 8, double); the transposed variants never do (measured on Sapphire Rapids).
+  // So the rows past the last multiple of 16 -- an output layer's few, none of a hidden one's
+  // in our presets -- go to Eigen, whose buffers live on the stack.
+  const Eigen::Index m_blas = (!ta && !tb) ? m / kBlasRowBlock * kBlasRowBlock : m;
+  if (m_blas > 0) {
+    blas_gemm<Scalar>(ta ? 'T' : 'N', tb ? 'T' : 'N', static_cast<int>(m_blas), static_cast<int>(n),
+                      static_cast<int>(k), a.data(), ld(a), b.data(), ld(b), accumulate ? Scalar(1) : Scalar(0),
+                      c.data(), ld(c));
+  }
+  if (m_blas < m) {
+    const Eigen::Index tail = m - m_blas;
+    eigen_gemm(a.bottomRows(tail), b, c.bottomRows(tail), accumulate);
+  }
 #else
   if (ta && tb) {
     eigen_gemm(a.transpose(), b.transpose(), c, accumulate);

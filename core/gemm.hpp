@@ -7,7 +7,9 @@
 // Not a general BLAS binding: only what Mlp needs. Shapes that do not agree are a bug in the
 // caller and abort (an Eigen assertion would vanish under NDEBUG). Allocates nothing per call
 // after the first (OpenBLAS keeps its packing buffers; Eigen's live on the stack, see
-// core/CMakeLists.txt). Safe to call from several threads at once.
+// core/CMakeLists.txt; the rows of an untransposed product past a multiple of 16 run on Eigen,
+// because OpenBLAS's AVX-512 kernels allocate for them). Safe to call from several threads at
+// once.
 #pragma once
 
 #include <Eigen/Core>

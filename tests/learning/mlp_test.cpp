@@ -559,6 +559,8 @@ TEST(Gemm, AgreesWithALoopForEveryTransposeOnBlocks) {
         check_gemm<float>(op_a, op_b, 70, 32, 300, accumulate);
         check_gemm<float>(op_a, op_b, 1, 32, 64, accumulate);
         check_gemm<float>(op_a, op_b, 10, 1, 5, accumulate);
+        check_gemm<float>(op_a, op_b, 16, 32, 64, accumulate);  // a whole row block, no tail
+        check_gemm<float>(op_a, op_b, 24, 32, 64, accumulate);  // a block and an 8-row tail
         check_gemm<double>(op_a, op_b, 33, 7, 129, accumulate);
       }
     }
