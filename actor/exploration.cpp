@@ -44,6 +44,17 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
     lo_.push_back(p.lo);
     hi_.push_back(p.hi);
   }
+  bound_lo_ = lo_;
+  bound_hi_ = hi_;
+  if (!(config.param_noise >= 0.0 && config.param_noise <= 1.0)) {
+    throw std::invalid_argument(
+        "exploration: param_noise must lie in [0, 1] (a fraction of each parameter's half range)");
+  }
+  if (config.param_noise > 0.0) {
+    for (size_t i = 0; i < lo_.size(); ++i) {
+      noise_std_.push_back(static_cast<float>(config.param_noise * 0.5 * (hi_[i] - lo_[i])));
+    }
+  }
   if (!config.random_param_lo.empty()) {
     if (config.random_param_lo.size() != lo_.size() || config.random_param_hi.size() != hi_.size()) {
       throw std::invalid_argument("exploration: random parameter ranges must list every parameter");
@@ -76,6 +87,10 @@ int EpsilonGreedy::select(std::span<const float> net_output, double epsilon, std
     }
   } else {
     std::copy(net_output.begin(), net_output.end(), stored.begin());
+    for (size_t i = 0; i < noise_std_.size(); ++i) {
+      float& v = stored[static_cast<size_t>(num_actions_) + i];
+      v = std::clamp(v + static_cast<float>(rng_.normal()) * noise_std_[i], bound_lo_[i], bound_hi_[i]);
+    }
   }
   return greedy(stored);
 }

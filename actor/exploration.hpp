@@ -6,6 +6,9 @@
 // ε-greedy: with probability ε the whole output vector is replaced by a random one (scores
 // U[-1, 1], each parameter uniform in its exploration range), and the stored transition
 // carries that random vector.
+// Parameter noise (param_noise > 0, not in the paper): on the other, greedy steps each
+// parameter gets Gaussian noise of std param_noise * (hi - lo) / 2 of its action-space bounds,
+// clamped to them; the discrete choice stays greedy and the stored vector carries the noise.
 // select() allocates nothing; not thread-safe (one per actor thread).
 #pragma once
 
@@ -26,6 +29,9 @@ struct ExplorationConfig {
   // Sampling range of each parameter for random actions; empty = the action space's bounds.
   std::vector<float> random_param_lo;
   std::vector<float> random_param_hi;
+  // Gaussian noise on the parameters of greedy steps, as a fraction of each parameter's half
+  // range (0: none, the paper's pure ε-greedy).
+  double param_noise = 0.0;
   // Demonstrations (pamdp train, HFO only): the share of episodes the scripted offense plays
   // instead of the actor, falling linearly to 0 over demo_anneal_updates learner updates (0:
   // constant). Their transitions go to replay like any other; the stored action is the scripted
@@ -64,6 +70,9 @@ class EpsilonGreedy {
   std::vector<bool> masked_;
   std::vector<float> lo_;
   std::vector<float> hi_;
+  std::vector<float> bound_lo_;  // the action space's bounds (parameter noise is clamped to them)
+  std::vector<float> bound_hi_;
+  std::vector<float> noise_std_;  // empty: no parameter noise
   Rng rng_;
 };
 

@@ -73,6 +73,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("exploration.epsilon_anneal_updates", c.exploration.epsilon_anneal_updates, 0, INT64_MAX);
   v.str_list("exploration.masked_actions", c.masked_actions);
   v.ranges("exploration.random_param_ranges", c.random_param_ranges);
+  v.real("exploration.param_noise", c.exploration.param_noise, 0.0, 1.0);
   v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
   v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
 

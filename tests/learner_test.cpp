@@ -143,6 +143,57 @@ TEST(Exploration, RandomActionsFollowThePaper) {
   EXPECT_EQ(stored, net);
 }
 
+TEST(Exploration, ParameterNoiseIsGaussianAroundTheGreedyParametersAndStaysInBounds) {
+  const ActionSpace& space = hfo::hfo_action_space();
+  ExplorationConfig cfg;
+  cfg.masked_actions = {hfo::kTackle};
+  cfg.param_noise = 0.1;
+  EpsilonGreedy eg(space, cfg, 5);
+  std::vector<float> net(10, 0.0F);
+  net[hfo::kKick] = 1.0F;
+  net[4 + hfo::param::kDashPower] = 40.0F;  // bounds [0, 100]: std 0.1 * 50 = 5
+  net[4 + hfo::param::kKickDir] = -30.0F;   // bounds [-180, 180]: std 18
+  net[4 + hfo::param::kKickPower] = 99.0F;  // bounds [0, 100]: std 5, clamped at 100
+  std::vector<float> stored(10);
+  const int n = 20000;
+  double sum_dash = 0;
+  double sq_dash = 0;
+  double sum_dir = 0;
+  double sq_dir = 0;
+  int at_max_power = 0;
+  for (int i = 0; i < n; ++i) {
+    ASSERT_EQ(eg.select(net, 0.0, stored), hfo::kKick);  // the discrete choice stays greedy
+    for (int a = 0; a < 4; ++a) {
+      EXPECT_EQ(stored[static_cast<size_t>(a)], net[static_cast<size_t>(a)]);  // scores untouched
+    }
+    const double dash = stored[4 + hfo::param::kDashPower] - 40.0;
+    const double dir = stored[4 + hfo::param::kKickDir] + 30.0;
+    sum_dash += dash;
+    sq_dash += dash * dash;
+    sum_dir += dir;
+    sq_dir += dir * dir;
+    const float power = stored[4 + hfo::param::kKickPower];
+    ASSERT_GE(power, 0.0F);
+    ASSERT_LE(power, 100.0F);
+    at_max_power += power == 100.0F ? 1 : 0;
+  }
+  // Means within ~5 standard errors of 0, standard deviations within 3 % of 5 and 18.
+  EXPECT_NEAR(sum_dash / n, 0.0, 5 * 5 / std::sqrt(n));
+  EXPECT_NEAR(sum_dir / n, 0.0, 5 * 18 / std::sqrt(n));
+  EXPECT_NEAR(std::sqrt(sq_dash / n), 5.0, 0.15);
+  EXPECT_NEAR(std::sqrt(sq_dir / n), 18.0, 0.54);
+  // P(99 + 5 z > 100) = P(z > 0.2) = 0.42: those draws are clamped to the bound.
+  EXPECT_NEAR(at_max_power / static_cast<double>(n), 0.42, 0.02);
+
+  // Without parameter noise a greedy step stores the network's vector unchanged.
+  cfg.param_noise = 0.0;
+  EpsilonGreedy plain(space, cfg, 5);
+  plain.select(net, 0.0, stored);
+  EXPECT_EQ(stored, net);
+  cfg.param_noise = 1.5;
+  EXPECT_THROW(EpsilonGreedy(space, cfg, 5), std::invalid_argument);
+}
+
 TEST(ReplayBuffer, FifoAndSampling) {
   ReplayBuffer rb(3, 1, 1);
   Rng rng(1);
