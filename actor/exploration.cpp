@@ -51,8 +51,8 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
         "exploration: param_noise must lie in [0, 1] (a fraction of each parameter's half range)");
   }
   if (config.param_noise > 0.0) {
-    for (size_t i = 0; i < lo_.size(); ++i) {
-      noise_std_.push_back(static_cast<float>(config.param_noise * 0.5 * (hi_[i] - lo_[i])));
+    for (size_t i = 0; i < bound_lo_.size(); ++i) {
+      noise_std_.push_back(static_cast<float>(config.param_noise * 0.5 * (bound_hi_[i] - bound_lo_[i])));
     }
   }
   if (!config.random_param_lo.empty()) {
