@@ -366,6 +366,9 @@ void LearnerServer::run() {
       }
     }
   }
+  // The shard count is otherwise refreshed once a second: a run shorter than that (a small task
+  // on a fast machine) would report 0 shards in its last metrics row.
+  counters_.shards = static_cast<int64_t>(shards_.size());
   publish_weights();
 }
 
