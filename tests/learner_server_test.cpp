@@ -108,6 +108,12 @@ TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   EXPECT_EQ(map->shard_sample_endpoints()->Get(0)->str(), sample_endpoint);
   EXPECT_NE(map->config_toml()->str().find("reach_stop"), std::string::npos);
 
+  // The learner publishes weights only as it updates, which starts with the first reply served
+  // below; a PUB drops what it sends before the SUB's subscription has reached it, and on a fast
+  // machine all 20 updates can be over within milliseconds of the join. Give the subscription
+  // time to arrive first (the SUB connected before the join, so this is ample).
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+
   // Serve sample requests: first one malformed reply (wrong widths), then good ones.
   net::Message id;
   net::Message req;
