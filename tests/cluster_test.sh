@@ -77,10 +77,11 @@ fi
 
 # 40,000 updates: on a fast machine 12,000 took under a second, before an actor that joined ahead of
 # the shards had received the map with them (a shard then inserted nothing).
+max_updates=40000
 # Ports are chosen by the OS (tcp://127.0.0.1:0) and read back from the learner's log.
 "${srv[@]}" "$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
   --set "cluster.learner_bind=tcp://$host:0" --set "cluster.weights_bind=tcp://$host:0" --set "cluster.advertise_host=$host" \
-  --set train.max_updates=40000 --set train.log_every_seconds=1 --set cluster.publish_every_updates=50 --set train.eval_every_updates=2000 \
+  --set train.max_updates=$max_updates --set train.log_every_seconds=1 --set cluster.publish_every_updates=50 --set train.eval_every_updates=2000 \
   --set replay.shards=2 "${learner_curve[@]}" ${CLUSTER_TEST_SETS:-} >"$work/logs/learner.log" 2>&1 &
 pids+=($!)
 join=""
@@ -113,7 +114,7 @@ for _ in $(seq 900); do
   sleep 0.1
 done
 if kill -0 "${pids[0]}" 2>/dev/null; then
-  fail "the learner did not reach 40000 updates within 90 s"
+  fail "the learner did not reach $max_updates updates within 90 s"
 fi
 wait "${pids[0]}" || fail "the learner exited with an error"
 
@@ -130,7 +131,7 @@ actors=$(column actors_joined)
 weights=$(column weights_version)
 malformed=$(column malformed_messages)
 echo "learner: updates=$updates episodes=$episodes shards=$shards actors=$actors weights_version=$weights malformed=$malformed"
-((updates >= 40000)) || fail "updates $updates < 40000"
+((updates >= max_updates)) || fail "updates $updates < $max_updates"
 ((episodes > 0)) || fail "no episode reports reached the learner"
 ((shards == 2)) || fail "expected 2 shards in the map, got $shards"
 ((actors >= 2)) || fail "expected 2 actors to join, got $actors"
