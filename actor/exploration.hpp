@@ -39,6 +39,10 @@ struct ExplorationConfig {
   // actions are the actor's own output).
   double demo_fraction = 0.0;
   int64_t demo_anneal_updates = 0;
+  // With cloning (ddpg.demo_bc_weight > 0): the agent's own steps also go into the cloning
+  // memory, each labelled with the scripted offense's action for the same state (DAgger), so the
+  // agent is taught in the states it reaches, not only in those its teacher does.
+  bool demo_relabel = false;
 };
 
 // The demonstration share after `updates` learner updates (see ExplorationConfig).

@@ -76,6 +76,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("exploration.param_noise", c.exploration.param_noise, 0.0, 1.0);
   v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
   v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
+  v.boolean("exploration.demo_relabel", c.exploration.demo_relabel);
 
   v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
@@ -423,6 +424,12 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              ": ddpg.demo_bc_weight > 0 clones demonstrations, and there are none: set "
                              "exploration.demo_fraction > 0 (the share of episodes the scripted offense plays), or "
                              "ddpg.demo_bc_weight = 0");
+  }
+  if (c.exploration.demo_relabel && c.ddpg.demo_bc_weight <= 0.0) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_relabel = true labels the agent's steps for cloning, and nothing "
+                             "clones: set ddpg.demo_bc_weight > 0 (with exploration.demo_fraction > 0), or "
+                             "exploration.demo_relabel = false");
   }
 }
 

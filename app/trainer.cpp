@@ -115,6 +115,10 @@ class Trainer {
       }
       demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
       demo_batch_.emplace(obs_dim_, width_, c.ddpg.batch_size);
+      if (c.exploration.demo_relabel) {
+        labelled_.emplace(env_->max_episode_steps(), obs_dim_, width_);
+        label_.resize(static_cast<size_t>(width_));
+      }
     }
   }
 
@@ -126,7 +130,9 @@ class Trainer {
   void log_tick(bool force);
   void run_eval();
   void save_best();
-  int store_demo_action();
+  // The scripted offense's action for obs_ as an actor output (score 1 for its action, -1 for
+  // the others, its parameters; the other parameters are the actor's own, net_out_).
+  int demo_action(std::span<float> out);
   // A full sampled batch as the update reads it (no copy).
   [[nodiscard]] BatchView view_of(const BatchBuffers& b) const;
   [[nodiscard]] bool should_stop() const;
@@ -153,6 +159,10 @@ class Trainer {
   // also go into replay_), and the backend, which is then the CPU one.
   std::optional<ReplayBuffer> demo_replay_;
   std::optional<BatchBuffers> demo_batch_;
+  // With exploration.demo_relabel: the agent's steps of the running episode with the scripted
+  // offense's action in place of the agent's, flushed into demo_replay_ at its end.
+  std::optional<EpisodeBuffer> labelled_;
+  std::vector<float> label_;
   CpuUpdateBackend* cpu_backend_ = nullptr;
   EpsilonGreedy explore_;
   hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
@@ -336,15 +346,15 @@ BatchView Trainer::view_of(const BatchBuffers& b) const {
   };
 }
 
-int Trainer::store_demo_action() {
+int Trainer::demo_action(std::span<float> out) {
   const ParamAction a = demo_.act(obs_);
   const int num_actions = space_.num_actions();
-  std::copy(net_out_.begin(), net_out_.end(), stored_.begin());
+  std::copy(net_out_.begin(), net_out_.end(), out.begin());
   for (int k = 0; k < num_actions; ++k) {
-    stored_[static_cast<size_t>(k)] = k == a.id ? 1.0F : -1.0F;
+    out[static_cast<size_t>(k)] = k == a.id ? 1.0F : -1.0F;
   }
   for (const int p : space_.actions[static_cast<size_t>(a.id)].param_indices) {
-    stored_[static_cast<size_t>(num_actions + p)] = a.params[static_cast<size_t>(p)];
+    out[static_cast<size_t>(num_actions + p)] = a.params[static_cast<size_t>(p)];
   }
   return a.id;
 }
@@ -397,10 +407,13 @@ TrainSummary Trainer::run() {
     // One episode.
     env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
     episode_.clear();
+    if (labelled_) {
+      labelled_->clear();
+    }
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
     const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
     const bool demo = share > 0.0 && explore_.rng().uniform() < share;
-    if (demo) {
+    if (demo || labelled_) {
       demo_.begin_episode();
     }
     float ep_return = 0.0F;
@@ -410,9 +423,15 @@ TrainSummary Trainer::run() {
       const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                         exploration_.epsilon_anneal_updates);
       ddpg_.act(obs_, net_out_);
-      const int id = demo ? store_demo_action() : explore_.select(net_out_, eps, stored_);
+      const int id = demo ? demo_action(stored_) : explore_.select(net_out_, eps, stored_);
+      if (labelled_ && !demo) {
+        demo_action(label_);  // before the step: the label is for the state the agent acted in
+      }
       sr = env_->step({id, std::span<const float>(stored_).subspan(static_cast<size_t>(num_actions))}, next_obs_);
       episode_.push(obs_, stored_, sr.reward, next_obs_);
+      if (labelled_ && !demo) {
+        labelled_->push(obs_, label_, sr.reward, next_obs_);
+      }
       ep_return += sr.reward;
       ++steps;
       ++env_steps_;
@@ -448,6 +467,9 @@ TrainSummary Trainer::run() {
     } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
 
     episode_.flush(replay_, c_.ddpg.gamma, demo && demo_replay_ ? &*demo_replay_ : nullptr);
+    if (labelled_ && !demo) {
+      labelled_->flush(*demo_replay_, c_.ddpg.gamma);
+    }
     backend_->sync_actor_to_host();
     ++episodes_;
     const bool success = sr.status == env_->success_status();

@@ -18,6 +18,7 @@
 #include "app/trainer.hpp"
 #include "core/files.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/scripted_offense.hpp"
 #include "envs/toy/reach_stop.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
@@ -628,6 +629,53 @@ TEST(Train, CloningIsLoggedAndItsDemonstrationsSurviveAResume) {
   fs::remove_all(dir);
 }
 
+TEST(Train, RelabellingPutsTheAgentsStatesWithTheScriptedActionsIntoTheCloningMemory) {
+  // exploration.demo_relabel: every step of every episode, the agent's too, is in the cloning
+  // memory, and every stored action there is what the scripted offense does in that state (the
+  // agent's own actions, random ones included, are in the main memory only).
+  const fs::path dir = fresh_dir("relabel");
+  app::ExperimentConfig c = hfo_demo_config(0.5, 20);
+  c.ddpg.demo_bc_weight = 1.0;
+  c.exploration.demo_relabel = true;
+  app::train(c, {dir.string(), false, true, nullptr});
+  int64_t demonstrated = 0;
+  int64_t agent = 0;
+  for (const auto& r : episode_rows(dir / "episodes.csv")) {
+    (r.policy == "scripted" ? demonstrated : agent) += r.steps;
+  }
+  ASSERT_GT(demonstrated, 0);
+  ASSERT_GT(agent, 0);
+  const hfo::HfoEnv env;
+  const ActionSpace& space = env.action_space();
+  const int obs = env.observation_size();
+  const int width = space.output_width();
+  ReplayBuffer labels(c.replay.capacity, obs, width);
+  load_replay_snapshot((dir / "demo_replay.bin").string(), labels);
+  ASSERT_EQ(labels.size(), demonstrated + agent);
+  ReplayBuffer replay(c.replay.capacity, obs, width);
+  load_replay_snapshot((dir / "replay.bin").string(), replay);
+  ASSERT_EQ(replay.size(), labels.size());
+
+  hfo::ScriptedOffense teacher;
+  const int64_t row = 2LL * obs + width + 3;
+  int64_t differs = 0;  // rows where the agent's action is not its teacher's
+  for (int64_t i = 0; i < labels.size(); ++i) {
+    const float* l = labels.raw().data() + i * row;
+    const float* r = replay.raw().data() + i * row;
+    ASSERT_TRUE(std::equal(l, l + obs, r)) << "row " << i << ": the same states in the same order";
+    const ParamAction a = teacher.act(std::span<const float>(l, static_cast<size_t>(obs)));
+    for (int k = 0; k < space.num_actions(); ++k) {
+      ASSERT_EQ(l[obs + k], k == a.id ? 1.0F : -1.0F) << "row " << i << " score " << k;
+    }
+    for (const int p : space.actions[static_cast<size_t>(a.id)].param_indices) {
+      ASSERT_EQ(l[obs + space.num_actions() + p], a.params[static_cast<size_t>(p)]) << "row " << i << " param " << p;
+    }
+    differs += std::equal(l + obs, l + obs + width, r + obs) ? 0 : 1;
+  }
+  EXPECT_GT(differs, agent / 2) << "the agent's own actions stayed in the main memory";
+  fs::remove_all(dir);
+}
+
 TEST(Train, ResumeIsBitForBit) {
   const fs::path a = fresh_dir("straight");
   const fs::path b = fresh_dir("halves");
@@ -803,6 +851,8 @@ TEST(Config, ErrorsNameTheKeyAndTheChoices) {
   expect_error("[ddpg]\ndemo_bc_weight = 1.0\n", {},
                "ddpg.demo_bc_weight > 0 clones demonstrations, and there are none");
   expect_error("[ddpg]\ndemo_bc_weight = -1.0\n", {}, "'ddpg.demo_bc_weight' must be within");
+  expect_error("[exploration]\ndemo_fraction = 0.5\ndemo_relabel = true\n", {},
+               "exploration.demo_relabel = true labels the agent's steps for cloning, and nothing clones");
 }
 
 TEST(Config, UpdateDevice) {
