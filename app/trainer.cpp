@@ -413,7 +413,8 @@ TrainSummary Trainer::run() {
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
     const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
     const bool demo = share > 0.0 && explore_.rng().uniform() < share;
-    if (demo || labelled_) {
+    const bool label = labelled_ && !demo;  // the agent plays, its steps get the teacher's labels
+    if (demo || label) {
       demo_.begin_episode();
     }
     float ep_return = 0.0F;
@@ -424,12 +425,12 @@ TrainSummary Trainer::run() {
                                         exploration_.epsilon_anneal_updates);
       ddpg_.act(obs_, net_out_);
       const int id = demo ? demo_action(stored_) : explore_.select(net_out_, eps, stored_);
-      if (labelled_ && !demo) {
+      if (label) {
         demo_action(label_);  // before the step: the label is for the state the agent acted in
       }
       sr = env_->step({id, std::span<const float>(stored_).subspan(static_cast<size_t>(num_actions))}, next_obs_);
       episode_.push(obs_, stored_, sr.reward, next_obs_);
-      if (labelled_ && !demo) {
+      if (label) {
         labelled_->push(obs_, label_, sr.reward, next_obs_);
       }
       ep_return += sr.reward;
@@ -467,7 +468,7 @@ TrainSummary Trainer::run() {
     } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
 
     episode_.flush(replay_, c_.ddpg.gamma, demo && demo_replay_ ? &*demo_replay_ : nullptr);
-    if (labelled_ && !demo) {
+    if (label) {
       labelled_->flush(*demo_replay_, c_.ddpg.gamma);
     }
     backend_->sync_actor_to_host();

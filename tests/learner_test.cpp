@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "actor/exploration.hpp"
@@ -505,6 +506,15 @@ std::vector<EpisodeCsvRow> episode_rows(const fs::path& csv) {
   return rows;
 }
 
+// Steps of the episodes in a run's episodes.csv: {played by the scripted offense, by the agent}.
+std::pair<int64_t, int64_t> steps_by_policy(const fs::path& dir) {
+  std::pair<int64_t, int64_t> steps{0, 0};
+  for (const auto& r : episode_rows(dir / "episodes.csv")) {
+    (r.policy == "scripted" ? steps.first : steps.second) += r.steps;
+  }
+  return steps;
+}
+
 app::ExperimentConfig hfo_demo_config(double demo_fraction, int64_t episodes) {
   app::ExperimentConfig c =
       app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/fast.toml",
@@ -598,11 +608,7 @@ TEST(Train, CloningIsLoggedAndItsDemonstrationsSurviveAResume) {
   auto expect_every_demonstrated_step = [&](const char* when) {
     ReplayBuffer demos(c.replay.capacity, env.observation_size(), width);
     load_replay_snapshot((dir / "demo_replay.bin").string(), demos);
-    int64_t demonstrated = 0;
-    int64_t agent = 0;
-    for (const auto& r : episode_rows(dir / "episodes.csv")) {
-      (r.policy == "scripted" ? demonstrated : agent) += r.steps;
-    }
+    const auto [demonstrated, agent] = steps_by_policy(dir);
     EXPECT_GT(demonstrated, 0);
     EXPECT_GT(agent, 0);
     EXPECT_EQ(demos.size(), demonstrated) << when;
@@ -638,11 +644,7 @@ TEST(Train, RelabellingPutsTheAgentsStatesWithTheScriptedActionsIntoTheCloningMe
   c.ddpg.demo_bc_weight = 1.0;
   c.exploration.demo_relabel = true;
   app::train(c, {dir.string(), false, true, nullptr});
-  int64_t demonstrated = 0;
-  int64_t agent = 0;
-  for (const auto& r : episode_rows(dir / "episodes.csv")) {
-    (r.policy == "scripted" ? demonstrated : agent) += r.steps;
-  }
+  const auto [demonstrated, agent] = steps_by_policy(dir);
   ASSERT_GT(demonstrated, 0);
   ASSERT_GT(agent, 0);
   const hfo::HfoEnv env;
