@@ -125,7 +125,7 @@ void LearnerServer::handle_join_socket() {
             }
             shard->dealer.connect(sample);
             shards_.push_back(std::move(shard));
-            ++map_version_;
+            shards_changed();
             log::info("learner: shard joined: insert {} sample {} ({} shards)", insert, sample, shards_.size());
             it = std::prev(shards_.end());
           }
@@ -288,8 +288,13 @@ void LearnerServer::drop_dead_shards() {
     return false;
   });
   if (shards_.size() != before) {
-    ++map_version_;
+    shards_changed();
   }
+}
+
+void LearnerServer::shards_changed() {
+  ++map_version_;
+  counters_.shards = static_cast<int64_t>(shards_.size());
 }
 
 void LearnerServer::run() {
@@ -355,7 +360,6 @@ void LearnerServer::run() {
     }
     if (ms_since(last_tick) >= 1000) {
       last_tick = Clock::now();
-      counters_.shards = static_cast<int64_t>(shards_.size());
       refresh_peers(true);
       if (waiting) {
         counters_.waiting_for_data_ms += ms_since(waiting_since);
@@ -366,9 +370,6 @@ void LearnerServer::run() {
       }
     }
   }
-  // The shard count is otherwise refreshed once a second: a run shorter than that (a small task
-  // on a fast machine) would report 0 shards in its last metrics row.
-  counters_.shards = static_cast<int64_t>(shards_.size());
   publish_weights();
 }
 

@@ -108,6 +108,8 @@ class LearnerServer {
   void handle_shard(Shard& shard);
   void request_samples(Shard& shard);
   void drop_dead_shards();
+  // After shards_ changed: a new map version, and the shard count the counters report.
+  void shards_changed();
   void send_map(std::span<const uint8_t> identity, uint32_t actor_index);
   void note_malformed(const char* what);
 
