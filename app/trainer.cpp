@@ -407,9 +407,6 @@ TrainSummary Trainer::run() {
     // One episode.
     env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
     episode_.clear();
-    if (labelled_) {
-      labelled_->clear();
-    }
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
     const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
     const bool demo = share > 0.0 && explore_.rng().uniform() < share;
