@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <deque>
 #include <limits>
@@ -55,8 +56,8 @@ std::optional<int64_t> field_as_integer(const std::string& row, size_t column) {
   return value;
 }
 
-// Rewrites `path` (header first) without the rows past `keep`, and without a last row cut off
-// mid-line; returns how many rows were dropped.
+// Rewrites `path` (header first) without the rows past `keep` or of the wrong width; returns how
+// many rows were dropped.
 size_t drop_rows_past(const fs::path& path, const std::string& header, const KeepUpTo& keep) {
   std::ifstream in(path);
   std::string kept = header + '\n';
@@ -81,6 +82,47 @@ size_t drop_rows_past(const fs::path& path, const std::string& header, const Kee
   return dropped;
 }
 
+// Cuts `path` back to just after its last newline and returns how many bytes went. A kill can
+// leave the last row unfinished, even one that lacks only its newline: a row appended after it
+// would run into it, and the file would hold two rows on one line.
+std::uintmax_t drop_unfinished_row(const fs::path& path) {
+  const std::uintmax_t size = fs::file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  constexpr std::uintmax_t kChunk = 4096;
+  std::string chunk;
+  for (std::uintmax_t end = size; end > 0;) {
+    const std::uintmax_t begin = end > kChunk ? end - kChunk : 0;
+    chunk.resize(end - begin);
+    in.seekg(static_cast<std::streamoff>(begin));
+    if (!in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()))) {
+      throw std::runtime_error("cannot read '" + path.string() + "': check the run directory's permissions");
+    }
+    const size_t newline = chunk.rfind('\n');
+    if (newline != std::string::npos) {
+      const std::uintmax_t keep = begin + newline + 1;
+      if (keep < size) {
+        fs::resize_file(path, keep);
+      }
+      return size - keep;
+    }
+    end = begin;
+  }
+  fs::resize_file(path, 0);
+  return size;
+}
+
+// Writes the rows gathered in `pending` with one write, so that the file only ever grows by whole
+// rows (a reader of a live run never sees half a row), and empties `pending`.
+void write_rows(std::ostringstream& pending, std::ofstream& out) {
+  const std::string_view rows = pending.view();
+  if (rows.empty()) {
+    return;
+  }
+  out.write(rows.data(), static_cast<std::streamsize>(rows.size()));
+  out.flush();
+  pending.str(std::string());
+}
+
 // Opens `path` for appending with `header` as its first line. A file that exists with another
 // header (an older format) is moved aside rather than mixed with rows of this format; with
 // `keep`, the rows past it are dropped first.
@@ -96,7 +138,12 @@ std::ofstream open_csv(const fs::path& path, const std::string& header, std::opt
       fs::rename(path, aside);
       log::warn("{} has another column layout; moved it to {} and started a new one", path.string(), aside.string());
       fresh = true;
-    } else if (keep) {
+    } else if (const std::uintmax_t cut = drop_unfinished_row(path); fs::file_size(path) == 0) {
+      fresh = true;  // not even the header was whole
+    } else if (cut > 0) {
+      log::info("{}: removed an unfinished last row ({} bytes) that a killed run left", path.string(), cut);
+    }
+    if (!fresh && keep) {
       const size_t dropped = drop_rows_past(path, header, *keep);
       if (dropped > 0) {
         log::info("{}: dropped {} rows written after the checkpoint (the resumed run writes them again)", path.string(),
@@ -146,41 +193,48 @@ RunLogs::RunLogs(const fs::path& dir, std::vector<std::string> extra_metric_colu
     // The "episode" column; without a limit only a row cut off by the kill goes.
     episodes_keep = KeepUpTo{0, resume_at->episodes.value_or(std::numeric_limits<int64_t>::max())};
   }
-  metrics_ = open_csv(dir / "metrics.csv", join(columns), metrics_keep);
-  episodes_ = open_csv(dir / "episodes.csv", join(episode_columns()), episodes_keep);
+  metrics_file_ = open_csv(dir / "metrics.csv", join(columns), metrics_keep);
+  episodes_file_ = open_csv(dir / "episodes.csv", join(episode_columns()), episodes_keep);
 }
 
 void RunLogs::metrics(const MetricsRow& r, std::span<const double> extras) {
   if (extras.size() != extras_.size()) {
     throw std::logic_error("RunLogs::metrics: wrong number of extra columns");
   }
-  metrics_ << r.wall_seconds << ',' << r.updates << ',' << r.env_steps << ',' << r.episodes << ',';
+  metrics_pending_ << r.wall_seconds << ',' << r.updates << ',' << r.env_steps << ',' << r.episodes << ',';
   if (r.epsilon) {
-    metrics_ << *r.epsilon;
+    metrics_pending_ << *r.epsilon;
   }
-  metrics_ << ',' << r.success_rate_100 << ',' << r.mean_return_100 << ',' << r.mean_steps_100 << ',' << r.critic_loss
-           << ',' << r.q_mean << ',' << r.updates_per_s << ',' << r.env_steps_per_s << ',';
+  metrics_pending_ << ',' << r.success_rate_100 << ',' << r.mean_return_100 << ',' << r.mean_steps_100 << ','
+                   << r.critic_loss << ',' << r.q_mean << ',' << r.updates_per_s << ',' << r.env_steps_per_s << ',';
   if (r.eval) {
-    metrics_ << r.eval->goal_rate << ',' << r.eval->avg_steps_to_goal << ',' << r.eval->avg_return;
+    metrics_pending_ << r.eval->goal_rate << ',' << r.eval->avg_steps_to_goal << ',' << r.eval->avg_return;
   } else {
-    metrics_ << ",,";
+    metrics_pending_ << ",,";
   }
   for (const double v : extras) {
-    metrics_ << ',' << v;
+    metrics_pending_ << ',' << v;
   }
-  metrics_ << '\n';
+  metrics_pending_ << '\n';
   flush();
 }
 
 void RunLogs::episode(const EpisodeRow& r) {
-  episodes_ << r.episode << ',' << r.wall_seconds << ',' << r.updates << ',' << r.actor << ',' << r.ret << ','
-            << r.steps << ',' << r.outcome << ',' << r.weights_version << ',' << (r.scripted ? "scripted" : "agent")
-            << '\n';
+  episodes_pending_ << r.episode << ',' << r.wall_seconds << ',' << r.updates << ',' << r.actor << ',' << r.ret << ','
+                    << r.steps << ',' << r.outcome << ',' << r.weights_version << ','
+                    << (r.scripted ? "scripted" : "agent") << '\n';
+  if (episodes_pending_.tellp() >= kEpisodeBytesPerWrite) {
+    write_rows(episodes_pending_, episodes_file_);
+  }
 }
 
 void RunLogs::flush() {
-  metrics_.flush();
-  episodes_.flush();
+  write_rows(metrics_pending_, metrics_file_);
+  write_rows(episodes_pending_, episodes_file_);
+}
+
+RunLogs::~RunLogs() {
+  flush();
 }
 
 void for_each_logged_episode(const fs::path& dir, const std::function<void(const LoggedEpisode&)>& visit) {

@@ -30,6 +30,7 @@
 #include <functional>
 #include <optional>
 #include <span>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -85,15 +86,22 @@ class RunLogs {
   // `extras` has one value per extra column given to the constructor.
   void metrics(const MetricsRow& row, std::span<const double> extras = {});
   void episode(const EpisodeRow& row);
-  void flush();
+  void flush();  // writes the rows gathered so far
+  ~RunLogs();
 
   static const std::vector<std::string>& metric_columns();  // without the extras
   static const std::vector<std::string>& episode_columns();
 
  private:
+  // Episode rows are written in blocks of about this many bytes, and at flush().
+  static constexpr std::streamoff kEpisodeBytesPerWrite = 64 * 1024;
+
   std::vector<std::string> extras_;
-  std::ofstream metrics_;
-  std::ofstream episodes_;
+  std::ofstream metrics_file_;
+  std::ofstream episodes_file_;
+  // Rows not yet written: a file grows by whole rows only.
+  std::ostringstream metrics_pending_;
+  std::ostringstream episodes_pending_;
 };
 
 // One row of episodes.csv as read back.

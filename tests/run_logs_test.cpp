@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -156,6 +157,77 @@ TEST(RunLogs, AResumeWithoutAnEpisodeCountKeepsEveryEpisodeRow) {
   std::vector<int64_t> numbers;
   for_each_logged_episode(dir, [&](const LoggedEpisode& e) { numbers.push_back(e.episode); });
   EXPECT_EQ(numbers, (std::vector<int64_t>{1, 2, 3, 4, 5}));
+  fs::remove_all(dir);
+}
+
+// A kill leaves episodes.csv cut at any byte of its last row. For every cut, `pamdp learner
+// --resume` (keep every whole row, number on after the last one that parses, append) must leave
+// a file numbered 1, 2, 3, ... with one row per line.
+TEST(RunLogs, EveryCutOfTheLastRowResumesWithOneRowPerNumber) {
+  const fs::path dir = fresh_dir("cut");
+  const EpisodeRow last{6, 12.25, 360, 1, -0.5, 20, "OUT_OF_TIME", 17};
+  std::ostringstream whole;
+  {
+    RunLogs logs(dir);
+    for (int64_t episode = 1; episode <= 6; ++episode) {
+      EpisodeRow row = last;
+      row.episode = episode;
+      logs.episode(row);
+    }
+  }
+  const std::string full = [&] {
+    std::ifstream in(dir / "episodes.csv");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }();
+  const size_t row_begin = full.rfind('\n', full.size() - 2) + 1;
+  for (size_t cut = row_begin; cut <= full.size(); ++cut) {
+    SCOPED_TRACE("episodes.csv cut to \"" + full.substr(row_begin, cut - row_begin) + "\"");
+    std::ofstream(dir / "episodes.csv", std::ios::trunc) << full.substr(0, cut);
+    {
+      RunLogs resumed(dir, {}, ResumePoint{100, std::nullopt});
+      int64_t count = 0;
+      for_each_logged_episode(dir, [&](const LoggedEpisode& e) { count = std::max(count, e.episode); });
+      for (int i = 0; i < 2; ++i) {
+        EpisodeRow row = last;
+        row.episode = ++count;
+        resumed.episode(row);
+      }
+    }
+    const auto e = lines_of(dir / "episodes.csv");
+    ASSERT_GE(e.size(), 8U);
+    for (size_t i = 1; i < e.size(); ++i) {
+      EXPECT_EQ(e[i].substr(0, e[i].find(',')), std::to_string(i)) << e[i];
+      EXPECT_EQ(std::count(e[i].begin(), e[i].end(), ','), 8) << e[i];
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// A reader of a live run (tests, `tail -f`, scripts) sees episodes.csv grow by whole rows only.
+TEST(RunLogs, EpisodesGrowByWholeRows) {
+  const fs::path dir = fresh_dir("whole");
+  const fs::path file = dir / "episodes.csv";
+  const auto last_byte = [&] {
+    std::ifstream in(file, std::ios::binary);
+    in.seekg(-1, std::ios::end);
+    return static_cast<char>(in.get());
+  };
+  {
+    RunLogs logs(dir);
+    const uintmax_t header = fs::file_size(file);
+    uintmax_t size = header;
+    for (int64_t episode = 1; episode <= 5000; ++episode) {
+      logs.episode(EpisodeRow{episode, 1234.5678, episode * 97, 3, -0.123456, 17, "OUT_OF_TIME", 4242});
+      if (fs::file_size(file) != size) {
+        size = fs::file_size(file);
+        ASSERT_EQ(last_byte(), '\n') << "after episode " << episode;
+      }
+    }
+    EXPECT_GT(size, header);  // 5,000 rows do not wait for flush()
+  }
+  EXPECT_EQ(lines_of(dir / "episodes.csv").size(), 5001U);  // the rest at destruction
   fs::remove_all(dir);
 }
 
