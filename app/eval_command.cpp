@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,6 +36,7 @@ struct EvalOptions {
   std::vector<std::string> sets;  // env.* overrides
   std::string trace;              // CSV of every step, when set
   std::string actor = "online";   // which actor of a checkpoint plays: online or target
+  bool agreement = false;         // the scripted offense plays, the checkpoint's actor is asked
   SimOptions sim;
 };
 
@@ -81,7 +83,45 @@ class TraceCsv {
   const Env& env_;
 };
 
-void print_result(const std::string& name, const EvalResult& r, bool json) {
+// `--agreement`: the teacher plays; the student is asked the same question at every step, and
+// the tally records how its answer differs.
+class Shadowed final : public Policy {
+ public:
+  Shadowed(Policy& teacher, Policy& student, PolicyAgreement& tally)
+      : teacher_(teacher), student_(student), tally_(tally) {}
+
+  void begin_episode() override {
+    teacher_.begin_episode();
+    student_.begin_episode();
+  }
+  ParamAction act(std::span<const float> obs) override {
+    const ParamAction t = teacher_.act(obs);
+    tally_.add(t, student_.act(obs));
+    return t;
+  }
+
+ private:
+  Policy& teacher_;
+  Policy& student_;
+  PolicyAgreement& tally_;
+};
+
+void print_agreement(const PolicyAgreement& a, const std::string& checkpoint) {
+  std::printf("\nagreement of %s's greedy actor with the scripted offense, in the offense's states (%lld steps)\n",
+              checkpoint.c_str(), static_cast<long long>(a.steps()));
+  std::printf("%-8s %8s %12s  %s\n", "offense", "steps", "same action", "|parameter difference|: median / 90th pct");
+  for (const PolicyAgreement::ActionRow& r : a.rows()) {
+    std::printf("%-8s %8lld %12.3f ", r.name.c_str(), static_cast<long long>(r.steps),
+                static_cast<double>(r.same) / static_cast<double>(r.steps));
+    for (const PolicyAgreement::ParamError& p : r.params) {
+      std::printf(" %s %.1f / %.1f", p.name.c_str(), p.median, p.p90);
+    }
+    std::printf("\n");
+  }
+}
+
+void print_result(const std::string& name, const EvalResult& r, bool json, const PolicyAgreement* agreement = nullptr,
+                  const std::string& checkpoint = {}) {
   std::printf("%-10s %9s %9s %18s %12s %10s\n", "policy", "episodes", "scoring", "avg steps to goal", "mean return",
               "avg steps");
   std::printf("%-10s %9d %9.3f %18.1f %12.3f %10.1f\n", name.c_str(), r.episodes, r.goal_rate, r.avg_steps_to_goal,
@@ -91,8 +131,16 @@ void print_result(const std::string& name, const EvalResult& r, bool json) {
     std::printf(" %s=%d", status.c_str(), count);
   }
   std::printf("\n");
+  if (agreement != nullptr) {
+    print_agreement(*agreement, checkpoint);
+  }
   if (json) {
-    std::printf("%s\n", to_json(r).c_str());
+    std::string line = to_json(r);
+    if (agreement != nullptr) {
+      line.pop_back();  // the closing brace
+      line += ",\"agreement\":" + agreement->to_json() + "}";
+    }
+    std::printf("%s\n", line.c_str());
   }
 }
 
@@ -185,6 +233,19 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
     std::copy(target.begin(), target.end(), ddpg.actor().params().begin());
   }
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
+  if (o.agreement) {
+    if (c.env.name != "hfo" &&
+        !(c.env.name == "hfo-server" && c.env.server_encoding == hfo_server::Encoding::kEmbedded)) {
+      throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
+                               o.checkpoint + " plays env '" + c.env.name +
+                               "' (use a checkpoint trained on hfo, or leave out --agreement)");
+    }
+    hfo::ScriptedOffense offense;
+    PolicyAgreement tally(env->action_space());
+    Shadowed shadowed(offense, policy, tally);
+    print_result("scripted", evaluate_with_progress(std::move(env), shadowed, o), o.json, &tally, o.checkpoint);
+    return;
+  }
   print_result("ddpg", evaluate_with_progress(std::move(env), policy, o), o.json);
 }
 
@@ -192,6 +253,11 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (!o.checkpoint.empty()) {
     run_checkpoint_eval(o, cmd);
     return;
+  }
+  if (o.agreement) {
+    throw std::runtime_error(
+        "--agreement compares a checkpoint's greedy actor with the scripted offense: give "
+        "--checkpoint FILE too");
   }
   if (cmd.count("--actor") > 0) {
     throw std::runtime_error("--actor " + o.actor + " picks a network of a checkpoint: give --checkpoint FILE too");
@@ -257,6 +323,10 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--trace", opts->trace,
                   "write every step to this CSV file: episode, step, action, its parameters, reward, status and "
                   "the observation the policy read");
+  cmd->add_flag("--agreement", opts->agreement,
+                "with --checkpoint: the scripted offense plays, and the checkpoint's greedy actor is asked in "
+                "every state; prints how often it picks the offense's action and how far its parameters are "
+                "(how well a cloned actor imitates its teacher)");
   opts->sim.add_to(*cmd);
   cmd->callback([opts, cmd] { run_eval(*opts, *cmd); });
 }

@@ -1,6 +1,8 @@
 #include "learner/evaluation.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -92,6 +94,99 @@ std::string to_json(const EvalResult& r) {
   j["avg_return"] = r.avg_return;
   j["avg_steps"] = r.avg_steps;
   j["outcomes"] = r.outcomes;
+  return j.dump();
+}
+
+PolicyAgreement::PolicyAgreement(const ActionSpace& space)
+    : space_(space),
+      taken_(static_cast<size_t>(space.num_actions()), 0),
+      same_(static_cast<size_t>(space.num_actions()), 0),
+      errors_(static_cast<size_t>(space.num_actions())) {
+  for (size_t a = 0; a < errors_.size(); ++a) {
+    errors_[a].resize(space.actions[a].param_indices.size());
+  }
+}
+
+void PolicyAgreement::add(const ParamAction& teacher, const ParamAction& student) {
+  if (teacher.id < 0 || teacher.id >= space_.num_actions() || student.id < 0 || student.id >= space_.num_actions()) {
+    throw std::logic_error("PolicyAgreement::add: an action id outside the action space");
+  }
+  const auto a = static_cast<size_t>(teacher.id);
+  ++steps_;
+  ++taken_[a];
+  same_[a] += student.id == teacher.id ? 1 : 0;
+  const std::vector<int>& owned = space_.actions[a].param_indices;
+  for (size_t k = 0; k < owned.size(); ++k) {
+    const auto i = static_cast<size_t>(owned[k]);
+    const ParamSpec& p = space_.params[i];
+    const double t =
+        std::clamp(static_cast<double>(teacher.params[i]), static_cast<double>(p.lo), static_cast<double>(p.hi));
+    const double s =
+        std::clamp(static_cast<double>(student.params[i]), static_cast<double>(p.lo), static_cast<double>(p.hi));
+    double d = std::abs(s - t);
+    const double range = static_cast<double>(p.hi) - static_cast<double>(p.lo);
+    if (range == 360.0) {
+      d = std::min(d, 360.0 - d);
+    }
+    errors_[a][k].push_back(static_cast<float>(d));
+  }
+}
+
+namespace {
+
+// The q-quantile of `v` (nearest rank); v is reordered.
+double quantile(std::vector<float>& v, double q) {
+  if (v.empty()) {
+    return 0.0;
+  }
+  const auto rank = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size()))) - (q > 0.0 ? 1 : 0);
+  const auto at = v.begin() + static_cast<std::ptrdiff_t>(std::min(rank, v.size() - 1));
+  std::nth_element(v.begin(), at, v.end());
+  return static_cast<double>(*at);
+}
+
+}  // namespace
+
+std::vector<PolicyAgreement::ActionRow> PolicyAgreement::rows() const {
+  std::vector<ActionRow> out;
+  for (size_t a = 0; a < taken_.size(); ++a) {
+    if (taken_[a] == 0) {
+      continue;
+    }
+    ActionRow row;
+    row.name = space_.actions[a].name;
+    row.steps = taken_[a];
+    row.same = same_[a];
+    const std::vector<int>& owned = space_.actions[a].param_indices;
+    for (size_t k = 0; k < owned.size(); ++k) {
+      std::vector<float> e = errors_[a][k];
+      ParamError pe;
+      pe.name = space_.params[static_cast<size_t>(owned[k])].name;
+      pe.median = quantile(e, 0.5);
+      pe.p90 = quantile(e, 0.9);
+      row.params.push_back(std::move(pe));
+    }
+    out.push_back(std::move(row));
+  }
+  return out;
+}
+
+std::string PolicyAgreement::to_json() const {
+  nlohmann::json j;
+  j["steps"] = steps_;
+  nlohmann::json actions = nlohmann::json::object();
+  for (const ActionRow& r : rows()) {
+    nlohmann::json a;
+    a["steps"] = r.steps;
+    a["same_action"] = static_cast<double>(r.same) / static_cast<double>(r.steps);
+    nlohmann::json params = nlohmann::json::object();
+    for (const ParamError& p : r.params) {
+      params[p.name] = {{"median", p.median}, {"p90", p.p90}};
+    }
+    a["params"] = std::move(params);
+    actions[r.name] = std::move(a);
+  }
+  j["actions"] = std::move(actions);
   return j.dump();
 }
 

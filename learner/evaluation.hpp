@@ -8,6 +8,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/policy.hpp"
 #include "envs/env.hpp"
@@ -49,5 +50,43 @@ uint64_t confirmation_seed(uint64_t run_seed, int64_t updates);
 // One JSON object (no newline) with keys episodes, goal_rate, avg_steps_to_goal, avg_return,
 // avg_steps, outcomes.
 std::string to_json(const EvalResult& r);
+
+// How closely a student policy follows its teacher in the teacher's own states (`pamdp eval
+// --checkpoint C --agreement`: the scripted offense plays, the checkpoint's greedy actor is asked
+// at every step). For each action the teacher took: how often the student took the same one, and
+// how far the student's parameters of that action were from the teacher's, in the parameter's
+// units, the student's clamped to the bounds first (the env clamps them so); an angle's
+// difference (a parameter whose range is 360) goes the short way round, so it is at most 180.
+class PolicyAgreement {
+ public:
+  explicit PolicyAgreement(const ActionSpace& space);
+
+  void add(const ParamAction& teacher, const ParamAction& student);
+
+  struct ParamError {
+    std::string name;
+    double median = 0.0;
+    double p90 = 0.0;  // the 90th percentile
+  };
+  struct ActionRow {
+    std::string name;
+    int64_t steps = 0;  // steps in which the teacher took this action
+    int64_t same = 0;   // ... and the student took it too
+    std::vector<ParamError> params;
+  };
+  // The actions the teacher took at least once, in the action space's order.
+  [[nodiscard]] std::vector<ActionRow> rows() const;
+  [[nodiscard]] int64_t steps() const { return steps_; }
+  // One JSON object (no newline): {"steps": N, "actions": {"DASH": {"steps", "same_action",
+  // "params": {"dash_power": {"median", "p90"}, ...}}, ...}}; same_action is a fraction.
+  [[nodiscard]] std::string to_json() const;
+
+ private:
+  ActionSpace space_;  // a copy: the env may be gone when the rows are read
+  int64_t steps_ = 0;
+  std::vector<int64_t> taken_;                           // per action
+  std::vector<int64_t> same_;                            // per action
+  std::vector<std::vector<std::vector<float>>> errors_;  // per action, per owned parameter
+};
 
 }  // namespace pamdp

@@ -184,6 +184,34 @@ TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
   EXPECT_GE(nlohmann::json::parse(last_line(target.output)).at("goal_rate").get<double>(), 0.8) << target.output;
 }
 
+// --agreement: the scripted offense plays (the table and its outcomes are the offense's own,
+// as `eval --goalie` gives them on the same starts), the checkpoint's actor is asked at every step.
+TEST(Cli, EvalAgreementLetsTheOffensePlayAndAsksTheCheckpoint) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v1-pn01-seed2-3m.ckpt";
+  const RunResult r =
+      run_pamdp("eval --checkpoint " + model + " --agreement --episodes 20 --seed 3 --json", Capture::kStdoutOnly);
+  const RunResult offense = run_pamdp("eval --goalie --episodes 20 --seed 3 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_EQ(offense.exit_code, 0) << offense.output;
+  EXPECT_NE(r.output.find("agreement of"), std::string::npos) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(last_line(r.output));
+  nlohmann::json played = j;
+  played.erase("agreement");
+  EXPECT_EQ(played, nlohmann::json::parse(last_line(offense.output)));
+  const nlohmann::json& a = j.at("agreement");
+  int steps = 0;
+  for (const auto& [name, action] : a.at("actions").items()) {
+    steps += action.at("steps").get<int>();
+    const double same = action.at("same_action").get<double>();
+    EXPECT_GE(same, 0.0) << name;
+    EXPECT_LE(same, 1.0) << name;
+  }
+  EXPECT_EQ(steps, a.at("steps").get<int>());
+  EXPECT_NEAR(j.at("avg_steps").get<double>() * 20, steps, 1e-6);
+  // The trained agent dashes where its teacher dashes nearly always.
+  EXPECT_GT(a.at("actions").at("DASH").at("same_action").get<double>(), 0.9) << j.dump();
+}
+
 TEST(Cli, EvalTraceRefusesAnUnwritablePath) {
   const RunResult r = run_pamdp("eval --episodes 1 --trace /nonexistent-dir/trace.csv");
   EXPECT_NE(r.exit_code, 0) << r.output;
@@ -226,6 +254,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"UnknownPolicy", "eval --policy foo", {"--policy", "foo"}},
                       BadInvocation{"UnknownActor", "eval --actor average", {"--actor", "average"}},
                       BadInvocation{"ActorWithoutCheckpoint", "eval --actor target", {"--actor", "--checkpoint"}},
+                      BadInvocation{"AgreementWithoutCheckpoint", "eval --agreement", {"--agreement", "--checkpoint"}},
                       BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
                       BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
                       // CLI11 answers these two with "A subcommand is required", naming neither the

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -203,6 +204,62 @@ TEST(ToJson, ParsesBackWithEveryKeyAndValue) {
   ASSERT_TRUE(j.at("outcomes").is_object());
   const auto outcomes = j.at("outcomes").get<std::map<std::string, int>>();
   EXPECT_EQ(outcomes, r.outcomes);
+}
+
+// PolicyAgreement on four steps worked by hand: a power in [0, 100] and an angle in [-180, 180].
+TEST(PolicyAgreement, CountsActionsAndMeasuresClampedAndWrappedDifferences) {
+  ActionSpace space;
+  space.params = {{"power", 0.0F, 100.0F}, {"angle", -180.0F, 180.0F}};
+  space.actions = {{"PUSH", {0}}, {"AIM", {1}}};
+  PolicyAgreement a(space);
+  const auto step = [&](int teacher_id, std::array<float, 2> teacher, int student_id, std::array<float, 2> student) {
+    a.add(ParamAction{teacher_id, teacher}, ParamAction{student_id, student});
+  };
+  step(0, {50.0F, 0.0F}, 0, {60.0F, 99.0F});    // PUSH, power off by 10 (the angle is not PUSH's)
+  step(0, {50.0F, 0.0F}, 1, {120.0F, 0.0F});    // AIM instead; power 120 is played as 100: off by 50
+  step(1, {0.0F, 170.0F}, 1, {0.0F, -170.0F});  // AIM, 340 degrees apart one way, 20 the other
+  step(1, {0.0F, 0.0F}, 0, {0.0F, 90.0F});      // PUSH instead, angle off by 90
+  EXPECT_EQ(a.steps(), 4);
+  const std::vector<PolicyAgreement::ActionRow> rows = a.rows();
+  ASSERT_EQ(rows.size(), 2U);
+  EXPECT_EQ(rows[0].name, "PUSH");
+  EXPECT_EQ(rows[0].steps, 2);
+  EXPECT_EQ(rows[0].same, 1);
+  ASSERT_EQ(rows[0].params.size(), 1U);
+  EXPECT_EQ(rows[0].params[0].name, "power");
+  EXPECT_DOUBLE_EQ(rows[0].params[0].median, 10.0);  // nearest rank: the first of two
+  EXPECT_DOUBLE_EQ(rows[0].params[0].p90, 50.0);
+  EXPECT_EQ(rows[1].name, "AIM");
+  EXPECT_EQ(rows[1].same, 1);
+  ASSERT_EQ(rows[1].params.size(), 1U);
+  EXPECT_DOUBLE_EQ(rows[1].params[0].median, 20.0);
+  EXPECT_DOUBLE_EQ(rows[1].params[0].p90, 90.0);
+
+  const nlohmann::json j = nlohmann::json::parse(a.to_json());
+  EXPECT_EQ(j.at("steps").get<int>(), 4);
+  EXPECT_DOUBLE_EQ(j.at("actions").at("PUSH").at("same_action").get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j.at("actions").at("AIM").at("params").at("angle").at("p90").get<double>(), 90.0);
+  EXPECT_THROW(a.add(ParamAction{2, std::array<float, 2>{}}, ParamAction{0, std::array<float, 2>{}}), std::logic_error);
+}
+
+// The scripted offense asked beside itself agrees everywhere, with no parameter difference; an
+// action the teacher never took gets no row.
+TEST(PolicyAgreement, APolicyAgreesWithItself) {
+  hfo::SoccerSimConfig config;
+  config.goalie = true;
+  hfo::HfoEnv env(config);
+  hfo::ScriptedOffense teacher;
+  hfo::ScriptedOffense student;
+  PolicyAgreement a(env.action_space());
+  evaluate(env, teacher, 20, 4, {}, [&](const EvalStep& s) { a.add(s.action, student.act(s.obs)); });
+  ASSERT_GT(a.steps(), 100);
+  for (const PolicyAgreement::ActionRow& r : a.rows()) {
+    EXPECT_NE(r.name, "TACKLE");
+    EXPECT_EQ(r.same, r.steps) << r.name;
+    for (const PolicyAgreement::ParamError& p : r.params) {
+      EXPECT_EQ(p.p90, 0.0) << r.name << " " << p.name;
+    }
+  }
 }
 
 // A run's screens and confirmations play starts no other evaluation of the run plays: the
