@@ -1,4 +1,5 @@
 // `pamdp learner`: the learner process of the distributed system (docs/protocol.md).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -142,6 +143,9 @@ void run_learner(const LearnerCliOptions& o) {
   RecentEpisodes recent;
   int64_t episode_count = meta.episodes;
   int64_t env_steps = meta.env_steps;  // steps of the episodes reported so far
+  // The run's clock goes on from the last episode logged, which a learner killed after its
+  // checkpoint logged later than the checkpoint's time: episodes.csv's wall_seconds never go back.
+  double logged_seconds = meta.elapsed_seconds;
   if (resume) {
     // One pass over episodes.csv. The last-100 training rates go on from the episodes logged
     // before. The episodes the actors reported after the last checkpoint were played, and their
@@ -150,6 +154,7 @@ void run_learner(const LearnerCliOptions& o) {
     int64_t after = 0;
     for_each_logged_episode(run_dir, [&](const LoggedEpisode& e) {
       recent.add(e.ret, e.steps, e.outcome == success);
+      logged_seconds = std::max(logged_seconds, e.wall_seconds);
       if (e.episode > episode_count) {
         episode_count = e.episode;
         env_steps += e.steps;
@@ -165,7 +170,7 @@ void run_learner(const LearnerCliOptions& o) {
   EvalResult last_eval;
   bool have_eval = false;
   const auto start = std::chrono::steady_clock::now();
-  const double base_seconds = meta.elapsed_seconds;
+  const double base_seconds = logged_seconds;
   auto elapsed = [&] {
     return base_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };

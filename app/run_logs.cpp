@@ -259,7 +259,7 @@ void for_each_logged_episode(const fs::path& dir, const std::function<void(const
       const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
       return ec == std::errc() && end == text.data() + text.size();
     };
-    if (!number(f[0], e.episode) || !number(f[4], e.ret) || !number(f[5], e.steps) ||
+    if (!number(f[0], e.episode) || !number(f[1], e.wall_seconds) || !number(f[4], e.ret) || !number(f[5], e.steps) ||
         !number(f[7], e.weights_version) || f[6].empty() || (f[8] != "agent" && f[8] != "scripted")) {
       continue;
     }

@@ -107,6 +107,7 @@ class RunLogs {
 // One row of episodes.csv as read back.
 struct LoggedEpisode {
   int64_t episode = 0;
+  double wall_seconds = 0.0;
   double ret = 0.0;
   int64_t steps = 0;
   std::string outcome;

@@ -250,6 +250,7 @@ TEST(RunLogs, AResumedRunReadsBackItsLastEpisodes) {
   ASSERT_EQ(last.size(), 100U);  // episodes 51-150; the cut-off row is skipped
   EXPECT_EQ(last.front().steps, 51);
   EXPECT_EQ(last.front().episode, 51);
+  EXPECT_DOUBLE_EQ(last.front().wall_seconds, 0.5);
   EXPECT_EQ(last.back().steps, 150);
   EXPECT_EQ(last.back().outcome, "GOAL");
   EXPECT_DOUBLE_EQ(last.back().ret, 10.5);

@@ -130,11 +130,14 @@ csv_episodes=$(column episodes)
 ge "$csv_episodes" "$ck_episodes" || fail "episodes $csv_episodes after resume, the checkpoint had $ck_episodes"
 # The updates after the checkpoint are redone and logged once: metrics.csv's updates never go
 # back. The episodes the actors played meanwhile stay logged, and the resumed learner numbers its
-# episodes after them: episodes.csv counts 1, 2, 3, ... with no number twice.
+# episodes after them: episodes.csv counts 1, 2, 3, ... with no number twice, and its clock
+# (wall_seconds) goes on from the last of them.
 updates_back=$(awk -F, 'NR > 2 && $2 < prev { print NR ": " prev " -> " $2; exit } NR > 1 { prev = $2 }' "$work/run/metrics.csv")
 [[ -z $updates_back ]] || fail "metrics.csv's updates go back after the resume (line $updates_back)"
 episodes_off=$(awk -F, 'NR > 1 && $1 != NR - 1 { print NR ": episode " $1; exit }' "$work/run/episodes.csv")
 [[ -z $episodes_off ]] || fail "episodes.csv is not numbered 1, 2, 3, ... after the resume (line $episodes_off)"
+clock_back=$(awk -F, 'NR > 2 && $2 < prev { print NR ": " prev " -> " $2; exit } NR > 1 { prev = $2 }' "$work/run/episodes.csv")
+[[ -z $clock_back ]] || fail "episodes.csv's wall_seconds go back after the resume (line $clock_back)"
 echo "learner: kill -9 at checkpoint updates $ck_updates, episodes $ck_episodes, weights v$ck_version -> resumed at $first updates, episodes $csv_episodes, same 2 shards + 2 actors back (actor 1 weights v$actor1_version -> v$(metric "${aurl[1]}" pamdp_actor_weights_version)), updates now $(updates) at $(since)"
 
 # --- SIGTERM: a resumable run directory ---------------------------------------------------------
