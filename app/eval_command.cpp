@@ -234,8 +234,7 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
   if (o.agreement) {
-    if (c.env.name != "hfo" &&
-        !(c.env.name == "hfo-server" && c.env.server_encoding == hfo_server::Encoding::kEmbedded)) {
+    if (!gives_embedded_features(c.env)) {
       throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
                                o.checkpoint + " plays env '" + c.env.name +
                                "' (use a checkpoint trained on hfo, or leave out --agreement)");
@@ -275,8 +274,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (c.env.name != "hfo" && c.env.name != "hfo-server") {
     throw std::runtime_error("--policy " + o.policy + " plays HFO; env '" + c.env.name + "' takes --checkpoint");
   }
-  if (o.policy == "scripted" && c.env.name == "hfo-server" &&
-      c.env.server_encoding != hfo_server::Encoding::kEmbedded) {
+  if (o.policy == "scripted" && !gives_embedded_features(c.env)) {  // env.name is hfo or hfo-server here
     throw std::runtime_error("--policy scripted reads the embedded encoding: leave env.server_encoding = embedded");
   }
   auto env = make_env(c.env);

@@ -411,9 +411,7 @@ void validate(const ExperimentConfig& c, const std::string& src) {
   if (c.replay.warmup < c.ddpg.batch_size) {
     throw std::runtime_error(src + ": replay.warmup must be at least ddpg.batch_size");
   }
-  const bool embedded_features =
-      c.env.name == "hfo" || (c.env.name == "hfo-server" && c.env.server_encoding == hfo_server::Encoding::kEmbedded);
-  if (c.exploration.demo_fraction > 0.0 && !embedded_features) {
+  if (c.exploration.demo_fraction > 0.0 && !gives_embedded_features(c.env)) {
     throw std::runtime_error(src +
                              ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
                              "HFO features: use env.name = \"hfo\" (or hfo-server with env.server_encoding = "

@@ -32,6 +32,12 @@ struct EnvConfig {
   std::string server_config_dir;  // empty: HFO_ROOT/bin/teams/base/config/formations-dt
 };
 
+// Whether the env gives the embedded simulator's features, the ones the scripted offense reads:
+// hfo, or hfo-server in the embedded encoding.
+inline bool gives_embedded_features(const EnvConfig& env) {
+  return env.name == "hfo" || (env.name == "hfo-server" && env.server_encoding == hfo_server::Encoding::kEmbedded);
+}
+
 struct ReplayConfig {
   int64_t capacity = 500000;
   int64_t warmup = 10000;  // transitions stored before the first update
