@@ -179,6 +179,8 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
   Gauge* size = &r.gauge("pamdp_replay_size_transitions", "Transitions held");
   Gauge* capacity = &r.gauge("pamdp_replay_capacity_transitions", "Transitions the ring holds (0 before joining)");
   Gauge* fill = &r.gauge("pamdp_replay_fill_ratio", "Transitions held / capacity");
+  Gauge* restored =
+      &r.gauge("pamdp_replay_restored_transitions", "Transitions restored from the snapshot at start (--snapshot)");
   r.on_collect([=, &server] {
     const ShardCounters c = server.counters();
     inserted->set(c.inserted);
@@ -193,6 +195,7 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
     size->set(static_cast<double>(c.size));
     capacity->set(static_cast<double>(c.capacity));
     fill->set(c.capacity > 0 ? static_cast<double>(c.size) / static_cast<double>(c.capacity) : 0.0);
+    restored->set(static_cast<double>(c.restored));
   });
   register_rate(r, *inserted, "pamdp_replay_inserts_per_second", "Transitions stored per second");
   register_rate(r, *sampled, "pamdp_replay_samples_per_second", "Transitions sampled per second");

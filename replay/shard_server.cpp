@@ -209,6 +209,7 @@ ShardCounters ShardServer::counters() const {
   c.transitions_dropped = transitions_dropped_.load(r);
   c.capacity = capacity_.load(r);
   c.inserts_held = inserts_held_pub_.load(r);
+  c.restored = restored_.load(r);
   return c;
 }
 
@@ -376,6 +377,7 @@ void ShardServer::take_cluster_map(const wire::ClusterMap& map, Clock::time_poin
     shard_ = std::make_unique<ReplayShard>(config, max_sample);
     if (!options_.snapshot_path.empty() && std::filesystem::exists(options_.snapshot_path)) {
       shard_->load_snapshot(options_.snapshot_path);
+      restored_.store(static_cast<int64_t>(shard_->buffer().size()), std::memory_order_relaxed);
       log::info("replay shard '{}': restored {} transitions from {}", options_.name, shard_->buffer().size(),
                 options_.snapshot_path);
     }

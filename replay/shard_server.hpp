@@ -143,6 +143,7 @@ struct ShardCounters {
   int64_t inserts_held = 0;         // 1 while the rate limiter holds inserts back
   int64_t map_version = 0;          // of the last ClusterMap; 0 before joining
   int64_t joins = 0;                // ClusterMaps taken (1 + re-joins)
+  int64_t restored = 0;             // transitions restored from the snapshot at start
 };
 
 // Builds the shard settings from a ClusterMap's config_toml; throws std::runtime_error if the
@@ -237,7 +238,8 @@ class ShardServer {
   std::atomic<bool> stop_{false};
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
-      size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0};
+      size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0},
+      restored_{0};
 };
 
 }  // namespace pamdp

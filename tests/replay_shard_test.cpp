@@ -961,6 +961,7 @@ TEST(ShardServer, SnapshotSurvivesStopAndStart) {
     FakeActor actor(ctx, first.server().insert_endpoint());
     actor.insert(make_rows(6, 70.0F));
     ASSERT_TRUE(eventually([&] { return first.server().counters().inserted == 6; }));
+    EXPECT_EQ(first.server().counters().restored, 0);  // no snapshot yet
     first.stop();
     EXPECT_EQ(first.error(), "");
   }
@@ -970,6 +971,7 @@ TEST(ShardServer, SnapshotSurvivesStopAndStart) {
   join(learner, second);
   EXPECT_TRUE(eventually([&] { return second.server().counters().size == 6; }));
   EXPECT_EQ(second.server().counters().inserted, 0);  // counted per process
+  EXPECT_EQ(second.server().counters().restored, 6);
   // Balanced limiter: 6 inserts, 5 samples; a sample of 4 needs 9 <= 1 * (6 - 1) + 4.
   FakeSampler sampler(ctx, second.server().sample_endpoint());
   sampler.request(1, 4);
