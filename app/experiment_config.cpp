@@ -77,6 +77,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
   v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
   v.boolean("exploration.demo_relabel", c.exploration.demo_relabel);
+  v.choice("exploration.demo_shot", c.demo_shot, shot_aim_choices());
 
   v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
@@ -429,6 +430,11 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              "clones: set ddpg.demo_bc_weight > 0 (with exploration.demo_fraction > 0), or "
                              "exploration.demo_relabel = false");
   }
+  if (c.demo_shot != hfo::ShotAim::kBestCourse && c.exploration.demo_fraction <= 0.0) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_shot aims the scripted offense's shots, and it plays no episodes: "
+                             "set exploration.demo_fraction > 0, or leave exploration.demo_shot = \"best-course\"");
+  }
 }
 
 }  // namespace
@@ -460,6 +466,12 @@ const Choices<hfo_server::Encoding>& server_encoding_choices() {
 const Choices<hfo::BodyAtReset>& body_at_reset_choices() {
   static const Choices<hfo::BodyAtReset> kChoices{
       {"carry", hfo::BodyAtReset::kCarry}, {"zero", hfo::BodyAtReset::kZero}, {"uniform", hfo::BodyAtReset::kUniform}};
+  return kChoices;
+}
+
+const Choices<hfo::ShotAim>& shot_aim_choices() {
+  static const Choices<hfo::ShotAim> kChoices{{"best-course", hfo::ShotAim::kBestCourse},
+                                              {"bottom-post", hfo::ShotAim::kBottomPost}};
   return kChoices;
 }
 

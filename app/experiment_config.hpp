@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "actor/exploration.hpp"
+#include "envs/hfo/scripted_offense.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/hfo_server/hfo_server_env.hpp"
 #include "learner/ddpg.hpp"
@@ -97,6 +98,9 @@ struct ExperimentConfig {
   // (the paper's code explores dash power in [-100, 100]).
   std::vector<std::pair<std::string, std::pair<float, float>>> random_param_ranges = {
       {"dash_power", {-100.0F, 100.0F}}};
+  // The scripted offense's shot when it demonstrates and labels (exploration.demo_shot), and
+  // in `pamdp eval --agreement` on a checkpoint trained with it.
+  hfo::ShotAim demo_shot = hfo::ShotAim::kBestCourse;
   ReplayConfig replay;
   TrainLoopConfig train;
   ClusterConfig cluster;
@@ -111,6 +115,7 @@ const Choices<hfo::Referee>& referee_choices();
 const Choices<hfo::BodyAtReset>& body_at_reset_choices();
 const Choices<std::string>& env_choices();
 const Choices<hfo_server::Encoding>& server_encoding_choices();
+const Choices<hfo::ShotAim>& shot_aim_choices();
 
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws
 // std::runtime_error with the key, the problem and the valid choices.

@@ -101,6 +101,7 @@ class Trainer {
         backend_(make_update_backend(ddpg_, c.ddpg.device)),
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
+        demo_(c.demo_shot),
         sample_rng_(mix_seeds(c.seed, 3)),
         batch_(obs_dim_, width_, c.ddpg.batch_size),
         episode_(env_->max_episode_steps(), obs_dim_, width_),

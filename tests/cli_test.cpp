@@ -212,6 +212,26 @@ TEST(Cli, EvalAgreementLetsTheOffensePlayAndAsksTheCheckpoint) {
   EXPECT_GT(a.at("actions").at("DASH").at("same_action").get<double>(), 0.9) << j.dump();
 }
 
+// --shot picks the scripted offense's aim for --policy scripted and for --agreement alike; with
+// a checkpoint it needs --agreement (the offense does not play otherwise).
+TEST(Cli, EvalShotAimsTheOffenseThatPlays) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v1-pn01-seed2-3m.ckpt";
+  const RunResult asked =
+      run_pamdp("eval --checkpoint " + model + " --agreement --shot bottom-post --episodes 20 --seed 3 --json",
+                Capture::kStdoutOnly);
+  const RunResult offense =
+      run_pamdp("eval --goalie --shot bottom-post --episodes 20 --seed 3 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(asked.exit_code, 0) << asked.output;
+  ASSERT_EQ(offense.exit_code, 0) << offense.output;
+  nlohmann::json played = nlohmann::json::parse(last_line(asked.output));
+  played.erase("agreement");
+  EXPECT_EQ(played, nlohmann::json::parse(last_line(offense.output)));
+
+  const RunResult refused = run_pamdp("eval --checkpoint " + model + " --shot bottom-post --episodes 1");
+  EXPECT_NE(refused.exit_code, 0) << refused.output;
+  EXPECT_NE(refused.output.find("add --agreement"), std::string::npos) << refused.output;
+}
+
 TEST(Cli, EvalTraceRefusesAnUnwritablePath) {
   const RunResult r = run_pamdp("eval --episodes 1 --trace /nonexistent-dir/trace.csv");
   EXPECT_NE(r.exit_code, 0) << r.output;
@@ -255,6 +275,10 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"UnknownActor", "eval --actor average", {"--actor", "average"}},
                       BadInvocation{"ActorWithoutCheckpoint", "eval --actor target", {"--actor", "--checkpoint"}},
                       BadInvocation{"AgreementWithoutCheckpoint", "eval --agreement", {"--agreement", "--checkpoint"}},
+                      BadInvocation{"UnknownShot", "eval --goalie --shot corner", {"--shot", "corner"}},
+                      BadInvocation{"ShotWithRandomPolicy",
+                                    "eval --policy random --shot bottom-post",
+                                    {"--shot", "--policy scripted"}},
                       BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
                       BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
                       // CLI11 answers these two with "A subcommand is required", naming neither the

@@ -4,6 +4,7 @@
 // against it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -280,6 +281,46 @@ TEST(HfoGoalie, ScriptedOffenseScoresClearlyLessAgainstGoalie) {
   EXPECT_LE(r_goalie.goal_rate, r_empty.goal_rate - 0.10) << to_json(r_goalie);
   EXPECT_GE(r_goalie.goal_rate, 0.60) << to_json(r_goalie);
   EXPECT_GE(r_goalie.outcomes.at("CAPTURED_BY_DEFENSE"), kEpisodes / 20) << to_json(r_goalie);
+}
+
+// Where the scripted offense's goals cross the goal line (y, m; the bottom post is at +7) over
+// `episodes` episodes against the goalie.
+std::vector<double> goal_crossings(ShotAim aim, int episodes) {
+  HfoEnv env(goalie_config(true));
+  ScriptedOffense policy(aim);
+  std::vector<float> obs(66);
+  std::vector<double> ys;
+  env.reset(7, obs);
+  for (int ep = 0; ep < episodes; ++ep) {
+    if (ep > 0) {
+      env.reset(obs);
+    }
+    StepResult r;
+    do {
+      r = env.step(policy.act(obs), obs);
+    } while (!r.terminal());
+    if (r.status == env.success_status()) {
+      ys.push_back(env.sim().state().ball.pos.y);
+    }
+  }
+  return ys;
+}
+
+// ShotAim::kBottomPost shoots inside the bottom post, so its goals go in on the bottom half of
+// the mouth; the best course goes in on both sides (the corner away from the keeper). A goal
+// from a ball dribbled in, or a shot bent by the kick noise, can land elsewhere, hence 90 %.
+TEST(HfoGoalie, BottomPostAimScoresOnTheBottomHalf) {
+  const auto share_bottom = [](const std::vector<double>& ys, double y0) {
+    return static_cast<double>(std::count_if(ys.begin(), ys.end(), [y0](double y) { return y > y0; })) /
+           static_cast<double>(ys.size());
+  };
+  const std::vector<double> post = goal_crossings(ShotAim::kBottomPost, 100);
+  const std::vector<double> best = goal_crossings(ShotAim::kBestCourse, 100);
+  ASSERT_GE(post.size(), 50U);
+  ASSERT_GE(best.size(), 50U);
+  EXPECT_GE(share_bottom(post, 2.0), 0.9);
+  EXPECT_LE(share_bottom(best, 2.0), 0.8);
+  EXPECT_GE(share_bottom(best, 2.0), 0.2);
 }
 
 }  // namespace

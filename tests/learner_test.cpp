@@ -855,6 +855,9 @@ TEST(Config, ErrorsNameTheKeyAndTheChoices) {
   expect_error("[ddpg]\ndemo_bc_weight = -1.0\n", {}, "'ddpg.demo_bc_weight' must be within");
   expect_error("[exploration]\ndemo_fraction = 0.5\ndemo_relabel = true\n", {},
                "exploration.demo_relabel = true labels the agent's steps for cloning, and nothing clones");
+  expect_error("[exploration]\ndemo_shot = 'corner'\n", {}, "best-course, bottom-post");
+  expect_error("[exploration]\ndemo_shot = 'bottom-post'\n", {},
+               "exploration.demo_shot aims the scripted offense's shots, and it plays no episodes");
 }
 
 TEST(Config, UpdateDevice) {

@@ -87,9 +87,12 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
   // margin is the goalie's cycles to reach the line minus the ball's cycles to pass it.
   const Vec2 across = unit(post_bottom - post_top);
   const double mouth = (post_bottom - post_top).r();
+  // kBottomPost walks the courses from the bottom post and stops at the first the ball reaches.
+  const bool first_reachable = aim_ == ShotAim::kBottomPost;
   double best_margin = -1e9;
   Vec2 best_accel;
-  for (int i = 0; i < kShotCourses; ++i) {
+  for (int n = 0; n < kShotCourses; ++n) {
+    const int i = first_reachable ? kShotCourses - 1 - n : n;
     const double along_mouth = kAimInsidePost + (mouth - 2.0 * kAimInsidePost) * i / (kShotCourses - 1);
     const Vec2 aim = post_top + across * along_mouth;
     const Vec2 u = unit(aim - ball);
@@ -115,6 +118,9 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
     if (margin > best_margin) {
       best_margin = margin;
       best_accel = u * v0 - vb;
+    }
+    if (first_reachable) {
+      break;
     }
   }
   const bool close = (goal - ball).r() <= kMustShootRange;
