@@ -299,6 +299,11 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (!o.shot.empty() && o.policy != "scripted") {
     throw std::runtime_error("--shot " + o.shot + " aims the scripted offense's shots: use it with --policy scripted");
   }
+  if (!o.shot.empty() && !c.env.hfo.goalie) {
+    throw std::runtime_error("--shot " + o.shot +
+                             " aims the scripted offense's shots past a goalie; on the empty goal it shoots at the "
+                             "centre: add --goalie, or leave out --shot");
+  }
   auto env = make_env(c.env);
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {

@@ -279,6 +279,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"ShotWithRandomPolicy",
                                     "eval --policy random --shot bottom-post",
                                     {"--shot", "--policy scripted"}},
+                      BadInvocation{"ShotWithoutGoalie", "eval --shot bottom-post", {"--shot", "--goalie"}},
                       BadInvocation{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag"}},
                       BadInvocation{"UnknownStart", "eval --start nowhere", {"--start", "nowhere"}},
                       // CLI11 answers these two with "A subcommand is required", naming neither the
