@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -32,12 +33,12 @@ struct EvalOptions {
   uint64_t seed = 1;
   bool json = false;
   std::string checkpoint;
-  std::string env;                // overrides env.name
-  std::vector<std::string> sets;  // env.* overrides
-  std::string trace;              // CSV of every step, when set
-  std::string actor = "online";   // which actor of a checkpoint plays: online or target
-  bool agreement = false;         // the scripted offense plays, the checkpoint's actor is asked
-  std::string shot;               // the scripted offense's shot aim; empty: see --shot
+  std::string env;                                // overrides env.name
+  std::vector<std::string> sets;                  // env.* overrides
+  std::string trace;                              // CSV of every step, when set
+  std::string actor = "online";                   // which actor of a checkpoint plays: online or target
+  bool agreement = false;                         // the scripted offense plays, the checkpoint's actor is asked
+  hfo::ShotAim shot = hfo::ShotAim::kBestCourse;  // the scripted offense's (--shot)
   SimOptions sim;
 };
 
@@ -180,19 +181,6 @@ void refuse_sim_options_on_server(const CLI::App& cmd) {
   }
 }
 
-// --shot, or `fallback` when it is not given.
-hfo::ShotAim shot_aim(const EvalOptions& o, hfo::ShotAim fallback) {
-  if (o.shot.empty()) {
-    return fallback;
-  }
-  for (const auto& [name, aim] : shot_aim_choices()) {
-    if (name == o.shot) {
-      return aim;
-    }
-  }
-  throw std::runtime_error("--shot " + o.shot + ": not a shot aim");  // CLI11 checked the choices
-}
-
 // `sets` applied to `c` with the config file's validation; only env.* keys.
 ExperimentConfig with_env_overrides(const ExperimentConfig& c, const std::vector<std::string>& sets) {
   for (const std::string& s : sets) {
@@ -247,10 +235,11 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
     std::copy(target.begin(), target.end(), ddpg.actor().params().begin());
   }
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
-  if (!o.shot.empty() && !o.agreement) {
-    throw std::runtime_error("--shot " + o.shot +
-                             " aims the scripted offense's shots; with --checkpoint the offense plays only with "
-                             "--agreement: add --agreement, or leave out --shot");
+  const bool shot_given = cmd.count("--shot") > 0;
+  if (shot_given && !o.agreement) {
+    throw std::runtime_error(
+        "--shot aims the scripted offense's shots; with --checkpoint the offense plays only with "
+        "--agreement: add --agreement, or leave out --shot");
   }
   if (o.agreement) {
     if (!gives_embedded_features(c.env)) {
@@ -258,7 +247,7 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
                                o.checkpoint + " plays env '" + c.env.name +
                                "' (use a checkpoint trained on hfo, or leave out --agreement)");
     }
-    hfo::ScriptedOffense offense(shot_aim(o, c.demo_shot));  // by default the teacher it learned from
+    hfo::ScriptedOffense offense(shot_given ? o.shot : c.demo_shot);  // by default the teacher it learned from
     PolicyAgreement tally(env->action_space());
     Shadowed shadowed(offense, policy, tally);
     print_result("scripted", evaluate_with_progress(std::move(env), shadowed, o), o.json, &tally, o.checkpoint);
@@ -296,18 +285,18 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (o.policy == "scripted" && !gives_embedded_features(c.env)) {  // env.name is hfo or hfo-server here
     throw std::runtime_error("--policy scripted reads the embedded encoding: leave env.server_encoding = embedded");
   }
-  if (!o.shot.empty() && o.policy != "scripted") {
-    throw std::runtime_error("--shot " + o.shot + " aims the scripted offense's shots: use it with --policy scripted");
+  if (cmd.count("--shot") > 0 && o.policy != "scripted") {
+    throw std::runtime_error("--shot aims the scripted offense's shots: use it with --policy scripted");
   }
-  if (!o.shot.empty() && !c.env.hfo.goalie) {
-    throw std::runtime_error("--shot " + o.shot +
-                             " aims the scripted offense's shots past a goalie; on the empty goal it shoots at the "
-                             "centre: add --goalie, or leave out --shot");
+  if (cmd.count("--shot") > 0 && !c.env.hfo.goalie) {
+    throw std::runtime_error(
+        "--shot aims the scripted offense's shots past a goalie; on the empty goal it shoots at the centre: add "
+        "--goalie, or leave out --shot");
   }
   auto env = make_env(c.env);
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {
-    policy = std::make_unique<hfo::ScriptedOffense>(shot_aim(o, hfo::ShotAim::kBestCourse));
+    policy = std::make_unique<hfo::ScriptedOffense>(o.shot);
   } else {
     // The paper's exploration draw: Tackle masked, dash power U[-100, 100] (reference §7.3).
     auto random = std::make_unique<RandomPolicy>(env->action_space(), o.seed ^ 0x5eedULL,
@@ -352,11 +341,12 @@ void register_eval(CLI::App& app) {
                 "with --checkpoint: the scripted offense plays, and the checkpoint's greedy actor is asked in "
                 "every state; prints how often it picks the offense's action and how far its parameters are "
                 "(how well a cloned actor imitates its teacher)");
+  const std::map<std::string, hfo::ShotAim> shots(shot_aim_choices().begin(), shot_aim_choices().end());
   cmd->add_option("--shot", opts->shot,
                   "the scripted offense's shot against a goalie: best-course (the best of nine courses) or "
                   "bottom-post (always inside the bottom post); default best-course, and with --agreement the "
                   "checkpoint's exploration.demo_shot")
-      ->check(CLI::IsMember({"best-course", "bottom-post"}));
+      ->transform(CLI::CheckedTransformer(shots, CLI::ignore_case));
   opts->sim.add_to(*cmd);
   cmd->callback([opts, cmd] { run_eval(*opts, *cmd); });
 }
