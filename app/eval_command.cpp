@@ -194,6 +194,12 @@ ExperimentConfig with_env_overrides(const ExperimentConfig& c, const std::vector
 // A trained actor, with the env and bounds of the run that wrote the checkpoint; `--env
 // hfo-server` plays it on the real server, in the embedded encoding when it was trained in-process.
 void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
+  const bool shot_given = cmd.count("--shot") > 0;
+  if (shot_given && !o.agreement) {  // before the checkpoint is read
+    throw std::runtime_error(
+        "--shot aims the scripted offense's shots; with --checkpoint the offense plays only with "
+        "--agreement: add --agreement, or leave out --shot");
+  }
   ExperimentConfig c = parse_experiment_config(read_checkpoint_config(o.checkpoint), o.checkpoint + " (config)", {});
   const int trained_width = observation_size(c.env);
   const std::string trained_env = c.env.name;
@@ -235,12 +241,6 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
     std::copy(target.begin(), target.end(), ddpg.actor().params().begin());
   }
   GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
-  const bool shot_given = cmd.count("--shot") > 0;
-  if (shot_given && !o.agreement) {
-    throw std::runtime_error(
-        "--shot aims the scripted offense's shots; with --checkpoint the offense plays only with "
-        "--agreement: add --agreement, or leave out --shot");
-  }
   if (o.agreement) {
     if (!gives_embedded_features(c.env)) {
       throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
@@ -285,10 +285,11 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   if (o.policy == "scripted" && !gives_embedded_features(c.env)) {  // env.name is hfo or hfo-server here
     throw std::runtime_error("--policy scripted reads the embedded encoding: leave env.server_encoding = embedded");
   }
-  if (cmd.count("--shot") > 0 && o.policy != "scripted") {
+  const bool shot_given = cmd.count("--shot") > 0;
+  if (shot_given && o.policy != "scripted") {
     throw std::runtime_error("--shot aims the scripted offense's shots: use it with --policy scripted");
   }
-  if (cmd.count("--shot") > 0 && !c.env.hfo.goalie) {
+  if (shot_given && !c.env.hfo.goalie) {
     throw std::runtime_error(
         "--shot aims the scripted offense's shots past a goalie; on the empty goal it shoots at the centre: add "
         "--goalie, or leave out --shot");
