@@ -33,10 +33,10 @@ struct EvalOptions {
   uint64_t seed = 1;
   bool json = false;
   std::string checkpoint;
-  std::string env;                                // overrides env.name
-  std::vector<std::string> sets;                  // env.* overrides
-  std::string trace;                              // CSV of every step, when set
-  std::string actor = "online";                   // which actor of a checkpoint plays: online or target
+  std::string env;                // overrides env.name
+  std::vector<std::string> sets;  // env.* overrides
+  std::string trace;              // CSV of every step, when set
+  std::string actor;  // which actor of a checkpoint plays: online, target, average; empty: the one its run evaluated
   bool agreement = false;                         // the scripted offense plays, the checkpoint's actor is asked
   hfo::ShotAim shot = hfo::ShotAim::kBestCourse;  // the scripted offense's (--shot)
   SimOptions sim;
@@ -235,12 +235,22 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
-  if (o.actor == "target") {
-    // The slowly moving (Polyak-averaged, tau) copy the critic's targets use.
-    const auto target = ddpg.target_actor().params();
-    std::copy(target.begin(), target.end(), ddpg.actor().params().begin());
+  if (o.actor == "average" && !ddpg.averages_actor()) {
+    throw std::runtime_error("--actor average: " + o.checkpoint +
+                             " keeps no actor average (its run had ddpg.actor_average_tau = 0); use --actor online "
+                             "or target");
   }
-  GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()));
+  // By default the copy its run's evaluations judged (and best.ckpt was chosen by).
+  const ActorCopy copy = o.actor == "online"    ? ActorCopy::kOnline
+                         : o.actor == "target"  ? ActorCopy::kTarget
+                         : o.actor == "average" ? ActorCopy::kAverage
+                                                : evaluated_copy(ddpg);
+  if (o.actor.empty() && copy == ActorCopy::kAverage) {
+    std::fprintf(stderr,
+                 "eval: %s plays its actor average (ddpg.actor_average_tau = %g; --actor online for the other)\n",
+                 o.checkpoint.c_str(), c.ddpg.actor_average_tau);
+  }
+  GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()), copy);
   if (o.agreement) {
     if (!gives_embedded_features(c.env)) {
       throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
@@ -332,9 +342,10 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
   cmd->add_option("--actor", opts->actor,
-                  "with --checkpoint: play the online actor, or the target actor (its soft-updated average)")
-      ->check(CLI::IsMember({"online", "target"}))
-      ->capture_default_str();
+                  "with --checkpoint: play the online actor, the target actor (the critic targets' soft-updated "
+                  "copy) or the actor average (ddpg.actor_average_tau > 0); default: the one its run's "
+                  "evaluations played (the average when it kept one)")
+      ->check(CLI::IsMember({"online", "target", "average"}));
   cmd->add_option("--trace", opts->trace,
                   "write every step to this CSV file: episode, step, action, its parameters, reward, status and "
                   "the observation the policy read");

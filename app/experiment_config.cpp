@@ -67,6 +67,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.choice("ddpg.device", c.ddpg.device, kDevices);
   v.real("ddpg.demo_bc_weight", c.ddpg.demo_bc_weight, 0.0, 1e6);
   v.boolean("ddpg.demo_q_filter", c.ddpg.demo_q_filter);
+  v.real("ddpg.actor_average_tau", c.ddpg.actor_average_tau, 0.0, 1.0);
 
   v.real("exploration.epsilon_start", c.exploration.epsilon_start, 0.0, 1.0);
   v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);

@@ -100,6 +100,8 @@ void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& 
   const auto target_critic = vec(ddpg.target_critic());
   const auto actor_adam = adam_state(fbb, ddpg.actor_optimizer());
   const auto critic_adam = adam_state(fbb, ddpg.critic_optimizer());
+  const auto average =
+      ddpg.averages_actor() ? vec(ddpg.actor_average()) : flatbuffers::Offset<flatbuffers::Vector<float>>();
   std::vector<uint64_t> rng_words;
   for (const auto& s : meta.rng_states) {
     rng_words.insert(rng_words.end(), s.begin(), s.end());
@@ -125,6 +127,10 @@ void save_checkpoint(const std::string& path, Ddpg& ddpg, const CheckpointMeta& 
   b.add_elapsed_seconds(meta.elapsed_seconds);
   b.add_update_credit(meta.update_credit);
   b.add_weights_version(meta.weights_version);
+  if (ddpg.averages_actor()) {
+    b.add_actor_average(average);
+    b.add_actor_average_updates(ddpg.actor_average_updates());
+  }
   wire::FinishCheckpointBuffer(fbb, b.Finish());
   const uint64_t sum = fnv1a64(fbb.GetBufferPointer(), fbb.GetSize());
   uint8_t trailer[kTrailerSize];
@@ -150,6 +156,12 @@ CheckpointMeta load_checkpoint(const std::string& path, Ddpg& ddpg) {
   restore_adam(ck->actor_adam(), ddpg.actor_optimizer(), "actor Adam state", path);
   restore_adam(ck->critic_adam(), ddpg.critic_optimizer(), "critic Adam state", path);
   ddpg.set_updates(ck->updates());
+  if (ck->actor_average() != nullptr) {
+    copy_into(ck->actor_average(), ddpg.actor_average().params(), "actor_average", path);
+    ddpg.set_actor_average_updates(ck->actor_average_updates());
+  } else {
+    ddpg.reset_actor_average();  // written without one (ddpg.actor_average_tau was 0, or an older build)
+  }
   CheckpointMeta meta;
   meta.config_toml = ck->config_toml() != nullptr ? ck->config_toml()->str() : "";
   meta.env_steps = ck->env_steps();
@@ -232,6 +244,7 @@ void warm_start_from_checkpoint(const std::string& path, Ddpg& ddpg) {
   widen_into(ck->critic(), critic_from, obs, extra, ddpg.critic(), "critic", path);
   widen_into(ck->target_actor(), actor_from, obs, extra, ddpg.target_actor(), "target_actor", path);
   widen_into(ck->target_critic(), critic_from, obs, extra, ddpg.target_critic(), "target_critic", path);
+  ddpg.reset_actor_average();  // this run's average starts at the weights it starts from
 }
 
 std::string read_checkpoint_config(const std::string& path) {

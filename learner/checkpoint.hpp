@@ -1,6 +1,7 @@
-// Checkpoints of a DDPG learner: actor, critic, both targets, both Adam states, counters, RNG
-// streams and the resolved config, in one FlatBuffers file (schemas/checkpoint.fbs), written
-// atomically (temp file + fsync + rename) so a crash never leaves a torn checkpoint.
+// Checkpoints of a DDPG learner: actor, critic, both targets, both Adam states, the actor's
+// evaluation average (with ddpg.actor_average_tau > 0), counters, RNG streams and the resolved
+// config, in one FlatBuffers file (schemas/checkpoint.fbs), written atomically (temp file +
+// fsync + rename) so a crash never leaves a torn checkpoint.
 // The file ends with an FNV-1a checksum of the buffer (a trailer; files without one still load).
 // Loading checks the checksum, verifies the buffer and every size before touching the learner; a
 // corrupt, truncated or mismatched file is refused with a message naming the file and the problem.

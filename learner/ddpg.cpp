@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <stdexcept>
 
 namespace pamdp {
@@ -33,6 +34,7 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       critic_(widths(obs_dim + space.output_width(), config.hidden, 1), actor_batch(config)),
       target_actor_(actor_.widths(), config.batch_size),
       target_critic_(critic_.widths(), config.batch_size),
+      actor_average_(actor_.widths(), 1),
       actor_adam_(actor_.num_params(), adam(config, config.actor_learning_rate)),
       critic_adam_(critic_.num_params(), adam(config, config.critic_learning_rate)),
       critic_in_(obs_dim + space.output_width(), actor_batch(config)),
@@ -46,6 +48,9 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   }
   if (config.demo_bc_weight < 0.0) {
     throw std::invalid_argument("ddpg.demo_bc_weight must be >= 0");
+  }
+  if (!(config.actor_average_tau >= 0.0 && config.actor_average_tau <= 1.0)) {
+    throw std::invalid_argument("ddpg.actor_average_tau must be in [0, 1]");
   }
   num_actions_ = space.num_actions();
   if (config.demo_bc_weight > 0.0) {
@@ -71,6 +76,26 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   // Targets start as exact copies (reference §7.2).
   std::copy(actor_.params().begin(), actor_.params().end(), target_actor_.params().begin());
   std::copy(critic_.params().begin(), critic_.params().end(), target_critic_.params().begin());
+  reset_actor_average();
+}
+
+void Ddpg::reset_actor_average() {
+  std::copy(actor_.params().begin(), actor_.params().end(), actor_average_.params().begin());
+  actor_average_at_ = updates_;
+}
+
+void Ddpg::track_actor_average() {
+  const int64_t k = updates_ - actor_average_at_;
+  if (config_.actor_average_tau <= 0.0 || k <= 0) {
+    return;
+  }
+  const auto rate = static_cast<float>(-std::expm1(static_cast<double>(k) * std::log1p(-config_.actor_average_tau)));
+  const auto online = actor_.params();
+  const auto avg = actor_average_.params();
+  for (size_t i = 0; i < avg.size(); ++i) {
+    avg[i] += rate * (online[i] - avg[i]);
+  }
+  actor_average_at_ = updates_;
 }
 
 void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int batch,
@@ -86,10 +111,11 @@ void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf
   }
 }
 
-void Ddpg::act(std::span<const float> obs, std::span<float> out) {
+void Ddpg::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
   assert(static_cast<int>(obs.size()) == obs_dim_ && static_cast<int>(out.size()) == output_width());
   single_in_.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), obs_dim_);
-  const auto raw = actor_.forward(single_in_);
+  Mlp<float>& net = copy == ActorCopy::kTarget ? target_actor_ : copy == ActorCopy::kAverage ? actor_average_ : actor_;
+  const auto raw = net.forward(single_in_);
   if (config_.bound == BoundMethod::kSquashing) {
     squash({raw.data(), static_cast<size_t>(raw.rows())}, bounds_, out);
   } else {

@@ -56,7 +56,16 @@ struct DdpgConfig {
   // Behaviour cloning of demonstrations (see the top of this file); 0 disables. CPU only.
   double demo_bc_weight = 0.0;
   bool demo_q_filter = true;  // clone only where Q(s, a_demo) > Q(s, pi(s))
+  // A Polyak average of the online actor's weights, moving by this rate per update (it spans
+  // ~1/tau updates), kept for evaluation only: training never reads it. The online actor's
+  // quality swings by several points between evaluations; its average over a long window plays
+  // steadier (Polyak & Juditsky 1992; for deep RL, Nikishin et al. 2018). 0 disables.
+  double actor_average_tau = 0.0;
 };
+
+// Which copy of the actor plays: the one training moves, the critic targets' soft-updated copy
+// (rate tau), or the evaluation average (rate actor_average_tau).
+enum class ActorCopy { kOnline, kTarget, kAverage };
 
 // A minibatch, one sample per column. Not owned.
 struct BatchView {
@@ -89,7 +98,7 @@ class Ddpg {
 
   // The actor's output for one observation, as actors execute and store it (after the squash
   // when the method is squashing). Writes output_width() values.
-  void act(std::span<const float> obs, std::span<float> out);
+  void act(std::span<const float> obs, std::span<float> out, ActorCopy copy = ActorCopy::kOnline);
   [[nodiscard]] int output_width() const { return bounds_.width(); }
   [[nodiscard]] int obs_dim() const { return obs_dim_; }
   [[nodiscard]] int num_actions() const { return num_actions_; }  // discrete scores before the parameters
@@ -102,6 +111,20 @@ class Ddpg {
   // updates(); update() calls it, and so does any other backend before each step.
   void schedule_learning_rates();
   void set_updates(int64_t n) { updates_ = n; }
+
+  // Moves the actor average toward the online actor as far as the updates since the last call
+  // would have moved it one update at a time: by 1 - (1 - actor_average_tau)^k, exact for an
+  // actor that changed only at the last of the k updates and close (the window is ~1/tau, k ~100)
+  // otherwise. Reads the host actor, so call it where that is current (after the backend's
+  // sync_actor_to_host). No-op with actor_average_tau = 0.
+  void track_actor_average();
+  // Restarts the average at the online actor, as of updates() (a warm start; a checkpoint
+  // written without an average).
+  void reset_actor_average();
+  [[nodiscard]] bool averages_actor() const { return config_.actor_average_tau > 0.0; }
+  Mlp<float>& actor_average() { return actor_average_; }
+  [[nodiscard]] int64_t actor_average_updates() const { return actor_average_at_; }  // updates() it last absorbed
+  void set_actor_average_updates(int64_t n) { actor_average_at_ = n; }
 
   [[nodiscard]] const DdpgConfig& config() const { return config_; }
   [[nodiscard]] const OutputBounds& bounds() const { return bounds_; }
@@ -123,6 +146,8 @@ class Ddpg {
   Mlp<float> critic_;
   Mlp<float> target_actor_;
   Mlp<float> target_critic_;
+  Mlp<float> actor_average_;
+  int64_t actor_average_at_ = 0;
   Adam<float> actor_adam_;
   Adam<float> critic_adam_;
   int64_t updates_ = 0;

@@ -16,6 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "app/experiment_config.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/ddpg.hpp"
+
 namespace {
 
 const std::string kPamdp = PAMDP_BIN_DIR "/pamdp";
@@ -184,6 +189,44 @@ TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
   EXPECT_GE(nlohmann::json::parse(last_line(target.output)).at("goal_rate").get<double>(), 0.8) << target.output;
 }
 
+// A checkpoint with an actor average plays it by default (its run's evaluations did), says so, and
+// --actor online/average pick either. Here the average is set to the target network's weights, so
+// "average" must answer exactly what --actor target answers. A checkpoint without an average
+// refuses --actor average, naming the key.
+TEST(Cli, EvalPlaysTheActorAverageByDefaultWhenTheRunKeptOne) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
+  pamdp::app::ExperimentConfig c = pamdp::app::parse_experiment_config(pamdp::read_checkpoint_config(model), model, {});
+  c.ddpg.actor_average_tau = 1e-5;
+  pamdp::hfo::HfoEnv env(c.env.hfo);
+  pamdp::Ddpg ddpg(env.observation_size(), env.action_space(), c.ddpg, 1);
+  pamdp::CheckpointMeta meta = pamdp::load_checkpoint(model, ddpg);
+  const auto target = ddpg.target_actor().params();
+  std::copy(target.begin(), target.end(), ddpg.actor_average().params().begin());
+  meta.config_toml = pamdp::app::to_toml(c);
+  const std::string averaged =
+      (std::filesystem::temp_directory_path() / ("pamdp_cli_average_" + std::to_string(::getpid()) + ".ckpt")).string();
+  pamdp::save_checkpoint(averaged, ddpg, meta);
+
+  const std::string eval = "eval --episodes 20 --json --checkpoint ";
+  const RunResult plain = run_pamdp(eval + averaged, Capture::kStdoutOnly);
+  const RunResult told = run_pamdp(eval + averaged);
+  const RunResult average = run_pamdp(eval + averaged + " --actor average", Capture::kStdoutOnly);
+  const RunResult online = run_pamdp(eval + averaged + " --actor online", Capture::kStdoutOnly);
+  const RunResult as_target = run_pamdp(eval + model + " --actor target", Capture::kStdoutOnly);
+  for (const RunResult* r : {&plain, &told, &average, &online, &as_target}) {
+    ASSERT_EQ(r->exit_code, 0) << r->output;
+  }
+  EXPECT_NE(told.output.find("plays its actor average"), std::string::npos) << told.output;
+  EXPECT_EQ(last_line(plain.output), last_line(average.output));
+  EXPECT_EQ(last_line(average.output), last_line(as_target.output));
+  EXPECT_NE(last_line(average.output), last_line(online.output));
+  std::filesystem::remove(averaged);
+
+  const RunResult refused = run_pamdp(eval + model + " --actor average");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("ddpg.actor_average_tau"), std::string::npos) << refused.output;
+}
+
 // --agreement: the scripted offense plays (the table and its outcomes are the offense's own,
 // as `eval --goalie` gives them on the same starts), the checkpoint's actor is asked at every step.
 TEST(Cli, EvalAgreementLetsTheOffensePlayAndAsksTheCheckpoint) {
@@ -272,7 +315,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInvocation{"ZeroEpisodes", "eval --episodes 0", {"--episodes", "0"}},
                       BadInvocation{"NonNumericEpisodes", "eval --episodes many", {"--episodes", "many"}},
                       BadInvocation{"UnknownPolicy", "eval --policy foo", {"--policy", "foo"}},
-                      BadInvocation{"UnknownActor", "eval --actor average", {"--actor", "average"}},
+                      BadInvocation{"UnknownActor", "eval --actor mean", {"--actor", "mean"}},
                       BadInvocation{"ActorWithoutCheckpoint", "eval --actor target", {"--actor", "--checkpoint"}},
                       BadInvocation{"AgreementWithoutCheckpoint", "eval --agreement", {"--agreement", "--checkpoint"}},
                       BadInvocation{"UnknownShot", "eval --goalie --shot corner", {"--shot", "corner"}},

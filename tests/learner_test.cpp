@@ -286,6 +286,62 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   EXPECT_EQ(d.updates(), 1);
 }
 
+// The evaluation average: it starts as the actor, moves by 1 - (1 - tau)^k toward it over k
+// updates (one call or k calls alike while the actor holds still), stands still without new
+// updates or with tau = 0, and act(kAverage) plays it.
+TEST(Ddpg, ActorAverageMovesByTheUpdatesSinceItsLastCall) {
+  toy::ReachStopEnv env;
+  DdpgConfig c = tiny_config();
+  c.actor_average_tau = 0.1;
+  Ddpg d(3, env.action_space(), c, 5);
+  const std::vector<float> p0(d.actor().params().begin(), d.actor().params().end());
+  ASSERT_TRUE(std::equal(p0.begin(), p0.end(), d.actor_average().params().begin()));
+  Rng rng(3);
+  d.actor().init_gaussian(rng, 0.5F);  // the trained actor, far from where the average began
+  const std::vector<float> p1(d.actor().params().begin(), d.actor().params().end());
+  d.track_actor_average();  // no update since the start: nothing to absorb
+  ASSERT_TRUE(std::equal(p0.begin(), p0.end(), d.actor_average().params().begin()));
+
+  d.set_updates(3);
+  d.track_actor_average();
+  for (size_t i = 0; i < p0.size(); ++i) {
+    ASSERT_NEAR(d.actor_average().params()[i], p0[i] + 0.271F * (p1[i] - p0[i]), 1e-6F) << i;  // 1 - 0.9^3
+  }
+  EXPECT_EQ(d.actor_average_updates(), 3);
+  Ddpg stepwise(3, env.action_space(), c, 5);
+  std::copy(p1.begin(), p1.end(), stepwise.actor().params().begin());
+  for (int k = 1; k <= 3; ++k) {
+    stepwise.set_updates(k);
+    stepwise.track_actor_average();
+  }
+  for (size_t i = 0; i < p0.size(); ++i) {
+    ASSERT_NEAR(stepwise.actor_average().params()[i], d.actor_average().params()[i], 1e-6F) << i;
+  }
+
+  const std::array<float, 3> obs{0.3F, -0.2F, 0.7F};
+  std::vector<float> avg_out(static_cast<size_t>(d.output_width()));
+  std::vector<float> online_out(avg_out.size());
+  d.act(obs, avg_out, ActorCopy::kAverage);
+  d.act(obs, online_out);
+  Eigen::MatrixXf in(3, 1);
+  in << obs[0], obs[1], obs[2];
+  const Eigen::MatrixXf expect = d.actor_average().forward(in);
+  for (int i = 0; i < d.output_width(); ++i) {
+    EXPECT_FLOAT_EQ(avg_out[static_cast<size_t>(i)], expect(i, 0));
+  }
+  EXPECT_NE(avg_out, online_out);
+
+  c.actor_average_tau = 0.0;
+  Ddpg off(3, env.action_space(), c, 5);
+  off.actor().init_gaussian(rng, 0.5F);
+  off.set_updates(1000);
+  off.track_actor_average();
+  EXPECT_TRUE(std::equal(p0.begin(), p0.end(), off.actor_average().params().begin()));
+  EXPECT_FALSE(off.averages_actor());
+  c.actor_average_tau = 1.5;
+  EXPECT_THROW(Ddpg(3, env.action_space(), c, 5), std::invalid_argument);
+}
+
 TEST(Ddpg, LearningRatesDecayLinearlyThenHold) {
   // lr 1e-3 (critic 2e-3) falls to 10 % over 4 updates: the update after k done uses
   // lr * (1 - 0.9 * min(k / 4, 1)).
@@ -807,6 +863,75 @@ TEST(Checkpoint, WarmStartWidensTheInputsExactly) {
     }
   }
   fs::remove_all(dir);
+}
+
+// The actor average is in the checkpoint with the update it last absorbed; a file without one
+// (tau was 0, or an older build) and a warm start begin it at the loaded actor.
+TEST(Checkpoint, ActorAverageRoundTrips) {
+  const fs::path dir = fresh_dir("average");
+  fs::create_directories(dir);
+  const std::string path = (dir / "a.ckpt").string();
+  toy::ReachStopEnv env;
+  DdpgConfig c = tiny_config();
+  c.actor_average_tau = 0.01;
+  Ddpg from(3, env.action_space(), c, 1);
+  Rng rng(7);
+  from.actor_average().init_gaussian(rng, 0.5F);
+  from.set_updates(9);
+  from.set_actor_average_updates(7);
+  save_checkpoint(path, from, {});
+  Ddpg back(3, env.action_space(), c, 2);
+  load_checkpoint(path, back);
+  EXPECT_TRUE(std::equal(from.actor_average().params().begin(), from.actor_average().params().end(),
+                         back.actor_average().params().begin()));
+  EXPECT_EQ(back.actor_average_updates(), 7);
+  EXPECT_EQ(back.updates(), 9);
+
+  DdpgConfig off = tiny_config();
+  Ddpg plain(3, env.action_space(), off, 3);
+  plain.set_updates(5);
+  save_checkpoint(path, plain, {});
+  load_checkpoint(path, back);
+  EXPECT_TRUE(
+      std::equal(plain.actor().params().begin(), plain.actor().params().end(), back.actor_average().params().begin()));
+  EXPECT_EQ(back.actor_average_updates(), 5);
+
+  save_checkpoint(path, from, {});
+  Ddpg warm(3, env.action_space(), c, 4);
+  warm_start_from_checkpoint(path, warm);
+  EXPECT_TRUE(
+      std::equal(from.actor().params().begin(), from.actor().params().end(), warm.actor_average().params().begin()));
+  EXPECT_EQ(warm.actor_average_updates(), 0);
+  fs::remove_all(dir);
+}
+
+// A run with an actor average: stopped and resumed, it keeps the same average as a run that never
+// stopped, and that average has moved away from where it began (the evaluations played it).
+TEST(Train, ActorAverageSurvivesAResume) {
+  const fs::path a = fresh_dir("avg_straight");
+  const fs::path b = fresh_dir("avg_halves");
+  auto config = [](int64_t updates) {
+    app::ExperimentConfig c = toy_config(updates);
+    c.ddpg.actor_average_tau = 1e-3;
+    return c;
+  };
+  app::train(config(3000), {a.string(), false, true, nullptr});
+  app::train(config(1950), {b.string(), false, true, nullptr});
+  app::train(config(3000), {b.string(), true, true, nullptr});
+  const auto average_of = [](const fs::path& ckpt, const app::ExperimentConfig& c) {
+    toy::ReachStopEnv env;
+    Ddpg d(3, env.action_space(), c.ddpg, 99);
+    load_checkpoint(ckpt.string(), d);
+    EXPECT_EQ(d.actor_average_updates(), d.updates());
+    return std::vector<float>(d.actor_average().params().begin(), d.actor_average().params().end());
+  };
+  const std::vector<float> straight = average_of(a / "checkpoint.ckpt", config(3000));
+  EXPECT_EQ(straight, average_of(b / "checkpoint.ckpt", config(3000)));
+  toy::ReachStopEnv env;
+  Ddpg start(3, env.action_space(), config(3000).ddpg, mix_seeds(config(3000).seed, 1));  // the trainer's
+  EXPECT_NE(straight, std::vector<float>(start.actor().params().begin(), start.actor().params().end()));
+  fs::remove_all(a);
+  fs::remove_all(b);
 }
 
 TEST(Config, DefaultsRoundTripAndOverrides) {
