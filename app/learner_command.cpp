@@ -95,6 +95,10 @@ void run_learner(const LearnerCliOptions& o) {
     log::info("learner: networks warm-started from {}", c.train.init_from);
   }
   meta.config_toml = config_text;
+  if (ddpg.averages_actor()) {
+    log::info("learner: evaluations and best.ckpt play the actor average (ddpg.actor_average_tau = {})",
+              c.ddpg.actor_average_tau);
+  }
   // Built after the checkpoint is loaded: a GPU backend starts from the host state.
   const std::unique_ptr<UpdateBackend> backend = make_update_backend(ddpg, c.ddpg.device);
 

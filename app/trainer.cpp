@@ -375,6 +375,10 @@ TrainSummary Trainer::run() {
     const std::string text = to_toml(c_);
     write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
   }
+  if (ddpg_.averages_actor()) {
+    log::info("train: evaluations and best.ckpt play the actor average (ddpg.actor_average_tau = {})",
+              c_.ddpg.actor_average_tau);
+  }
   std::optional<ResumePoint> resume_at;
   if (o_.resume) {
     resume_at = ResumePoint{static_cast<int64_t>(ddpg_.updates()), static_cast<int64_t>(episodes_)};
