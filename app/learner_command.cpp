@@ -219,13 +219,9 @@ void run_learner(const LearnerCliOptions& o) {
     learner_metrics.on_update(s, ddpg.updates());
     last_stats = s;
     const int64_t every = c.train.eval_every_updates;
-    const bool eval_now = every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0;
-    if (ddpg.averages_actor() && (eval_now || ddpg.updates() % c.cluster.publish_every_updates == 0)) {
+    if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
       backend->sync_actor_to_host();
-      ddpg.track_actor_average();
-    }
-    if (eval_now) {
-      backend->sync_actor_to_host();
+      ddpg.track_actor_average();  // between the weight broadcasts, which track it too
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration, evaluated_copy(ddpg));
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, screening_seed(c.seed, ddpg.updates()));
       have_eval = true;
