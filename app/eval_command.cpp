@@ -36,8 +36,9 @@ struct EvalOptions {
   std::string env;                // overrides env.name
   std::vector<std::string> sets;  // env.* overrides
   std::string trace;              // CSV of every step, when set
-  std::string actor;  // which actor of a checkpoint plays: online, target, average; empty: the one its run evaluated
-  bool agreement = false;                         // the scripted offense plays, the checkpoint's actor is asked
+  ActorCopy actor =
+      ActorCopy::kOnline;  // which actor of a checkpoint plays (--actor; unset: the one its run evaluated)
+  bool agreement = false;  // the scripted offense plays, the checkpoint's actor is asked
   hfo::ShotAim shot = hfo::ShotAim::kBestCourse;  // the scripted offense's (--shot)
   SimOptions sim;
 };
@@ -235,17 +236,15 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
-  if (o.actor == "average" && !ddpg.averages_actor()) {
+  const bool actor_given = cmd.count("--actor") > 0;
+  if (actor_given && o.actor == ActorCopy::kAverage && !ddpg.averages_actor()) {
     throw std::runtime_error("--actor average: " + o.checkpoint +
                              " keeps no actor average (its run had ddpg.actor_average_tau = 0); use --actor online "
                              "or target");
   }
   // By default the copy its run's evaluations judged (and best.ckpt was chosen by).
-  const ActorCopy copy = o.actor == "online"    ? ActorCopy::kOnline
-                         : o.actor == "target"  ? ActorCopy::kTarget
-                         : o.actor == "average" ? ActorCopy::kAverage
-                                                : evaluated_copy(ddpg);
-  if (o.actor.empty() && copy == ActorCopy::kAverage) {
+  const ActorCopy copy = actor_given ? o.actor : evaluated_copy(ddpg);
+  if (!actor_given && copy == ActorCopy::kAverage) {
     std::fprintf(stderr,
                  "eval: %s plays its actor average (ddpg.actor_average_tau = %g; --actor online for the other)\n",
                  o.checkpoint.c_str(), c.ddpg.actor_average_tau);
@@ -277,7 +276,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
         "--checkpoint FILE too");
   }
   if (cmd.count("--actor") > 0) {
-    throw std::runtime_error("--actor " + o.actor + " picks a network of a checkpoint: give --checkpoint FILE too");
+    throw std::runtime_error("--actor picks a network of a checkpoint: give --checkpoint FILE too");
   }
   ExperimentConfig c;
   c.env.name = o.env.empty() ? "hfo" : o.env;
@@ -341,11 +340,13 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"hfo", "hfo-server", "reach_stop"}));
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
+  const std::map<std::string, ActorCopy> actors{
+      {"online", ActorCopy::kOnline}, {"target", ActorCopy::kTarget}, {"average", ActorCopy::kAverage}};
   cmd->add_option("--actor", opts->actor,
                   "with --checkpoint: play the online actor, the target actor (the critic targets' soft-updated "
                   "copy) or the actor average (ddpg.actor_average_tau > 0); default: the one its run's "
                   "evaluations played (the average when it kept one)")
-      ->check(CLI::IsMember({"online", "target", "average"}));
+      ->transform(CLI::CheckedTransformer(actors, CLI::ignore_case));
   cmd->add_option("--trace", opts->trace,
                   "write every step to this CSV file: episode, step, action, its parameters, reward, status and "
                   "the observation the policy read");
