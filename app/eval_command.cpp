@@ -356,9 +356,10 @@ void register_eval(CLI::App& app) {
                 "(how well a cloned actor imitates its teacher)");
   const std::map<std::string, hfo::ShotAim> shots(shot_aim_choices().begin(), shot_aim_choices().end());
   cmd->add_option("--shot", opts->shot,
-                  "the scripted offense's shot against a goalie: best-course (the best of nine courses) or "
-                  "bottom-post (always inside the bottom post); default best-course, and with --agreement the "
-                  "checkpoint's exploration.demo_shot")
+                  "the scripted offense's shot against a goalie: best-course (the best of nine courses), "
+                  "bottom-post (always inside the bottom post) or bottom-side (inside the bottom post, dribbling "
+                  "toward that side and waiting longer for the shot from far out); default best-course, and with "
+                  "--agreement the checkpoint's exploration.demo_shot")
       ->transform(CLI::CheckedTransformer(shots, CLI::ignore_case));
   opts->sim.add_to(*cmd);
   cmd->callback([opts, cmd] { run_eval(*opts, *cmd); });

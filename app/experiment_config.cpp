@@ -472,7 +472,8 @@ const Choices<hfo::BodyAtReset>& body_at_reset_choices() {
 
 const Choices<hfo::ShotAim>& shot_aim_choices() {
   static const Choices<hfo::ShotAim> kChoices{{"best-course", hfo::ShotAim::kBestCourse},
-                                              {"bottom-post", hfo::ShotAim::kBottomPost}};
+                                              {"bottom-post", hfo::ShotAim::kBottomPost},
+                                              {"bottom-side", hfo::ShotAim::kBottomSide}};
   return kChoices;
 }
 

@@ -321,6 +321,25 @@ TEST(HfoGoalie, BottomPostAimScoresOnTheBottomHalf) {
   EXPECT_GE(share_bottom(post, 2.0), 0.9);
   EXPECT_LE(share_bottom(best, 2.0), 0.8);
   EXPECT_GE(share_bottom(best, 2.0), 0.2);
+  // kBottomSide shoots as kBottomPost does, so its goals go in on the same side.
+  const std::vector<double> side = goal_crossings(ShotAim::kBottomSide, 100);
+  ASSERT_GE(side.size(), 50U);
+  EXPECT_GE(share_bottom(side, 2.0), 0.9);
+}
+
+// kBottomSide's patience from far out and its dribble toward the bottom post beat the goalie
+// more often than kBottomPost, which shoots the same way: .856 against .799 on 4,000 episodes (.864
+// against .813 on these 1,000 starts), so it is 4 points up at least (sampling noise about ±.013).
+TEST(HfoGoalie, BottomSideScoresMoreThanBottomPost) {
+  const auto rate = [](ShotAim aim) {
+    HfoEnv env(goalie_config(true));
+    ScriptedOffense policy(aim);
+    return evaluate(env, policy, 1000, 11);
+  };
+  const EvalResult post = rate(ShotAim::kBottomPost);
+  const EvalResult side = rate(ShotAim::kBottomSide);
+  EXPECT_GE(side.goal_rate, post.goal_rate + 0.04) << to_json(side) << " against " << to_json(post);
+  EXPECT_GE(side.goal_rate, 0.84) << to_json(side);
 }
 
 }  // namespace
