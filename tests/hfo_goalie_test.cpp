@@ -328,8 +328,8 @@ TEST(HfoGoalie, BottomPostAimScoresOnTheBottomHalf) {
 }
 
 // kBottomSide's patience from far out and its dribble toward the bottom post beat the goalie
-// more often than kBottomPost, which shoots the same way: .856 against .799 on 4,000 episodes (.864
-// against .813 on these 1,000 starts), so it is 4 points up at least (sampling noise about ±.013).
+// more often than kBottomPost, which shoots the same way: .90 against .80 on 4,000 episodes (.906
+// against .813 on these 1,000 starts), so it is 6 points up at least (sampling noise about ±.012).
 TEST(HfoGoalie, BottomSideScoresMoreThanBottomPost) {
   const auto rate = [](ShotAim aim) {
     HfoEnv env(goalie_config(true));
@@ -338,8 +338,8 @@ TEST(HfoGoalie, BottomSideScoresMoreThanBottomPost) {
   };
   const EvalResult post = rate(ShotAim::kBottomPost);
   const EvalResult side = rate(ShotAim::kBottomSide);
-  EXPECT_GE(side.goal_rate, post.goal_rate + 0.04) << to_json(side) << " against " << to_json(post);
-  EXPECT_GE(side.goal_rate, 0.84) << to_json(side);
+  EXPECT_GE(side.goal_rate, post.goal_rate + 0.06) << to_json(side) << " against " << to_json(post);
+  EXPECT_GE(side.goal_rate, 0.87) << to_json(side);
 }
 
 }  // namespace
