@@ -23,16 +23,21 @@ constexpr int kShotCourses = 9;
 constexpr double kDribbleSpeed = 0.9;
 // Aim this far inside a post (ball radius, post radius and a margin for the kick noise).
 constexpr double kAimInsidePost = 1.6;
-// ShotAim::kBottomSide: the margin a shot needs is kSideShootMargin at kSideMarginDistance from
-// the goal centre and grows by kSideMarginSlope per metre farther out; the dribble heads for the
-// point kSideDribbleOffset of the half mouth from the goal centre toward the bottom post, with
-// the ball rolling at kSideDribbleSpeed. Tuned for the highest scoring rate on 10,000-episode
-// sets of starts, and checked on others (docs/results.md).
-constexpr double kSideShootMargin = -1.9;
-constexpr double kSideMarginDistance = 20.0;
-constexpr double kSideMarginSlope = 0.4;
-constexpr double kSideDribbleOffset = 0.25;
-constexpr double kSideDribbleSpeed = 0.85;
+// When to shoot and where to dribble. A shot needs a margin of at least `margin` at
+// kRuleDistance from the goal centre, growing by `slope` per metre farther out; the dribble
+// rolls the ball at `dribble_speed` toward the point `dribble_offset` of the half mouth from the
+// goal centre toward the bottom post. kBestCourse and kBottomPost keep the fixed rule above;
+// kBottomSide's was tuned for the highest scoring rate on 10,000-episode sets of starts and
+// checked on others (docs/results.md).
+struct ShootingRule {
+  double margin;
+  double slope;
+  double dribble_offset;
+  double dribble_speed;
+};
+constexpr double kRuleDistance = 20.0;
+constexpr ShootingRule kFixedRule{kShootMargin, 0.0, 0.0, kDribbleSpeed};
+constexpr ShootingRule kBottomSideRule{-1.9, 0.4, 0.25, 0.85};
 
 // Position of a landmark triple (sin, cos, proximity) in the agent's body frame.
 Vec2 body_frame(std::span<const float> f, int index) {
@@ -99,8 +104,8 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
   const double mouth = (post_bottom - post_top).r();
   // kBottomPost and kBottomSide walk the courses from the bottom post and stop at the first the
   // ball reaches.
-  const bool side = aim_ == ShotAim::kBottomSide;
-  const bool first_reachable = aim_ == ShotAim::kBottomPost || side;
+  const bool first_reachable = aim_ == ShotAim::kBottomPost || aim_ == ShotAim::kBottomSide;
+  const ShootingRule& rule = aim_ == ShotAim::kBottomSide ? kBottomSideRule : kFixedRule;
   double best_margin = -1e9;
   Vec2 best_accel;
   for (int n = 0; n < kShotCourses; ++n) {
@@ -137,16 +142,15 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
   }
   const double to_goal = (goal - ball).r();
   const bool close = to_goal <= kMustShootRange;
-  const double needed = side ? kSideShootMargin + kSideMarginSlope * (to_goal - kSideMarginDistance) : kShootMargin;
+  const double needed = rule.margin + rule.slope * (to_goal - kRuleDistance);
   if (best_margin >= needed || (close && best_margin > -1e9)) {
     params_[param::kKickPower] = static_cast<float>(kMaxKickPower);
     params_[param::kKickDir] = static_cast<float>(std::atan2(best_accel.y, best_accel.x) * kRadToDeg);
     return {kKick, params_};
   }
-  // Dribble: the ball rolls toward the goal centre (kBottomSide: a point toward the bottom post)
-  // at kDribbleSpeed (kBottomSide: kSideDribbleSpeed).
-  const Vec2 target = side ? goal + across * (kSideDribbleOffset * 0.5 * mouth) : goal;
-  const Vec2 accel = unit(target - ball) * (side ? kSideDribbleSpeed : kDribbleSpeed) - vb;
+  // Dribble: the ball rolls toward the goal centre, or the rule's point toward the bottom post.
+  const Vec2 target = goal + across * (rule.dribble_offset * 0.5 * mouth);
+  const Vec2 accel = unit(target - ball) * rule.dribble_speed - vb;
   params_[param::kKickPower] = static_cast<float>(std::min(kMaxKickPower, accel.r() / rate));
   params_[param::kKickDir] = static_cast<float>(std::atan2(accel.y, accel.x) * kRadToDeg);
   return {kKick, params_};
