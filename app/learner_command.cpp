@@ -220,8 +220,7 @@ void run_learner(const LearnerCliOptions& o) {
     last_stats = s;
     const int64_t every = c.train.eval_every_updates;
     if (every > 0 && c.train.eval_episodes > 0 && ddpg.updates() % every == 0) {
-      backend->sync_actor_to_host();
-      ddpg.track_actor_average();  // between the weight broadcasts, which track it too
+      backend->sync_actor_to_host();  // moves the actor average too, as the weight broadcasts do
       GreedyActorPolicy policy(ddpg, env->action_space(), exploration, evaluated_copy(ddpg));
       last_eval = evaluate(*eval_env, policy, c.train.eval_episodes, screening_seed(c.seed, ddpg.updates()));
       have_eval = true;

@@ -247,7 +247,6 @@ void Trainer::run_eval() {
     return;
   }
   backend_->sync_actor_to_host();
-  ddpg_.track_actor_average();
   GreedyActorPolicy policy(ddpg_, space_, exploration_, evaluated_copy(ddpg_));
   last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, screening_seed(c_.seed, ddpg_.updates()));
   have_eval_ = true;
@@ -462,7 +461,6 @@ TrainSummary Trainer::run() {
         update_credit_ -= 1.0;
         if (ddpg_.updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {
           backend_->sync_actor_to_host();
-          ddpg_.track_actor_average();
         }
       }
       if (replay_.size() < c_.replay.warmup) {
@@ -476,7 +474,6 @@ TrainSummary Trainer::run() {
       labelled_->flush(*demo_replay_, c_.ddpg.gamma);
     }
     backend_->sync_actor_to_host();
-    ddpg_.track_actor_average();
     ++episodes_;
     const bool success = sr.status == env_->success_status();
     if (!demo) {  // the training rates are the agent's own

@@ -115,8 +115,8 @@ class Ddpg {
   // Moves the actor average toward the online actor as far as the updates since the last call
   // would have moved it one update at a time: by 1 - (1 - actor_average_tau)^k, exact for an
   // actor that changed only at the last of the k updates and close (the window is ~1/tau, k ~100)
-  // otherwise. Reads the host actor, so call it where that is current (after the backend's
-  // sync_actor_to_host). No-op with actor_average_tau = 0.
+  // otherwise. Reads the host actor, so it is called where that is current: the backend's
+  // sync_actor_to_host calls it. No-op with actor_average_tau = 0.
   void track_actor_average();
   // Restarts the average at the online actor, as of updates() (a warm start; a checkpoint
   // written without an average).

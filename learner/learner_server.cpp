@@ -78,8 +78,7 @@ void LearnerServer::send_map(std::span<const uint8_t> identity, uint32_t actor_i
 }
 
 void LearnerServer::publish_weights() {
-  backend_.sync_actor_to_host();
-  ddpg_.track_actor_average();  // the host actor is current here (no-op without an average)
+  backend_.sync_actor_to_host();  // and moves the actor average
   Mlp<float>& actor = ddpg_.actor();
   ++counters_.weights_version;
   wire::build_policy_weights(fbb_->weights, static_cast<uint64_t>(counters_.weights_version), ddpg_.updates(),

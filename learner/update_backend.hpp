@@ -36,9 +36,14 @@ class UpdateBackend {
   // Copies the device state into ddpg(): sync_to_host everything a checkpoint holds (both
   // networks, both targets, both Adam states and step counts), sync_actor_to_host only the
   // online actor's parameters (acting, evaluation, weight broadcasts; ~3 MB at the paper's
-  // widths). Both wait for queued updates. No-ops on the CPU.
+  // widths). Both wait for queued updates; the copies are no-ops on the CPU.
+  // sync_actor_to_host then moves the actor average (Ddpg::track_actor_average), since the host
+  // actor is current there: every point that reads the actor also feeds the average.
   virtual void sync_to_host() = 0;
-  virtual void sync_actor_to_host() = 0;
+  void sync_actor_to_host() {
+    download_actor();
+    ddpg_.track_actor_average();
+  }
   // Replaces the device state with ddpg()'s (after a checkpoint was loaded into it). The
   // constructor does this once. No-op on the CPU.
   virtual void load_from_host() = 0;
@@ -46,6 +51,8 @@ class UpdateBackend {
   Ddpg& ddpg() { return ddpg_; }
 
  protected:
+  virtual void download_actor() = 0;  // the online actor's parameters into ddpg().actor()
+
   Ddpg& ddpg_;
 };
 
@@ -65,10 +72,11 @@ class CpuUpdateBackend final : public UpdateBackend {
   }
   UpdateStats finish() override { return last_; }
   void sync_to_host() override {}
-  void sync_actor_to_host() override {}
   void load_from_host() override {}
 
  private:
+  void download_actor() override {}
+
   UpdateStats last_;
 };
 

@@ -155,8 +155,6 @@ class CudaUpdateBackend final : public UpdateBackend {
     ddpg_.critic_optimizer().set_steps(critic_steps_);
   }
 
-  void sync_actor_to_host() override { device_->download_actor(ddpg_.actor().params().data()); }
-
   void load_from_host() override {
     device_->upload(host_state());
     actor_steps_ = ddpg_.actor_optimizer().steps();
@@ -164,6 +162,8 @@ class CudaUpdateBackend final : public UpdateBackend {
   }
 
  private:
+  void download_actor() override { device_->download_actor(ddpg_.actor().params().data()); }
+
   [[nodiscard]] UpdateStats convert(const cuda::DeviceStats& s) const {
     const int params = params_per_sample_ * ddpg_.config().batch_size;
     return {s.critic_loss,      s.q_mean,          s.target_mean,
