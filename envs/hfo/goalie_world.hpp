@@ -1,0 +1,134 @@
+// The goalie's world model and the librcsc actions it calls, as agent2d's goalie sees them.
+//
+// HFO's goalie is agent2d's (HFO `src/role_goalie.cpp` and the bhv_goalie_* files) on
+// librcsc, with full state: its world model is the exact server state at the start of the
+// cycle. agent2d plays the defense as the right side, so the server sends it every position
+// mirrored (x -> -x, y -> -y, angles + 180): in its own frame its goal is at x = -52.5 and
+// the attackers come from +x. Everything in this header works in that frame, so that the
+// rules and constants carried over from agent2d and librcsc read as they do there; the
+// goalie's decision (goalie.hpp) converts once, at its boundary.
+//
+// Nothing here allocates; every call is O(intercept horizon) at most.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "envs/hfo/geometry.hpp"
+
+namespace pamdp::hfo::agent2d {
+
+// A player as the world model holds it (pos, vel as the server stores them: post-decay).
+struct PlayerView {
+  Vec2 pos;
+  Vec2 vel;
+  double body_deg = 0.0;
+  bool tackling = false;  // frozen after a tackle (librcsc isTackling)
+};
+
+// The goalie's own state (librcsc SelfObject with full state).
+struct SelfView {
+  Vec2 pos;
+  Vec2 vel;
+  double body_deg = 0.0;
+  double stamina = kStaminaMax;
+  double effort = 1.0;
+  double recovery = 1.0;
+  double capacity = kStaminaCapacity;
+  bool frozen = false;  // after its own tackle
+};
+
+// librcsc WorldModel, reduced to what the goalie reads, in the goalie's frame.
+struct GoalieWorld {
+  static constexpr int kMaxOpponents = 3;
+  SelfView self;
+  Vec2 ball_pos;
+  Vec2 ball_vel;
+  // Opponents sorted by distance to the ball (WorldModel::opponentsFromBall).
+  std::array<PlayerView, kMaxOpponents> opponents{};
+  int num_opponents = 0;
+  // Cycles since the goalie's last catch command; a large value when it has not caught.
+  int since_catch = 1000;
+
+  // Derived values, as librcsc computes them (set by finish(), which the builder calls).
+  double ball_dist_from_self = 0.0;
+  double ball_angle_from_self_deg = 0.0;  // global direction of the ball from the goalie
+  bool exist_kickable_opponent = false;   // WorldModel::existKickableOpponent()
+  bool self_kickable = false;             // SelfObject::isKickable() (full state: buffer 0.055)
+
+  void finish();
+};
+
+// One way for the goalie to reach the ball (librcsc InterceptInfo).
+struct InterceptInfo {
+  enum class Mode : uint8_t { kNormal, kExhaust };
+  Mode mode = Mode::kExhaust;
+  int turn_cycle = 10000;
+  int dash_cycle = 10000;
+  double dash_power = 100000.0;
+  double dash_angle_deg = 0.0;  // first dash direction, global (in the goalie's frame)
+  Vec2 self_pos{-10000.0, 0.0};
+  double ball_dist = 10000000.0;
+  double stamina = 0.0;
+  [[nodiscard]] int reach_cycle() const { return turn_cycle + dash_cycle; }
+};
+
+// librcsc InterceptTable: ball path cache, the goalie's own ways to the ball, and the
+// opponents' and teammates' reach cycles (1000 = cannot within the horizon).
+struct InterceptTable {
+  static constexpr int kMaxCycle = 30;                 // InterceptTable::MAX_CYCLE
+  static constexpr int kMaxSelfCache = 2 * (kMaxCycle + 2);
+  std::array<Vec2, kMaxCycle + 2> ball_cache{};
+  int ball_cache_size = 0;
+  std::array<InterceptInfo, kMaxSelfCache> self_cache{};
+  int self_cache_size = 0;
+  int self_reach_cycle = 1000;
+  int self_exhaust_reach_cycle = 1000;
+  int opponent_reach_cycle = 1000;
+  int teammate_reach_cycle = 1000;  // HFO's defense has no field players here: always 1000
+};
+
+// Fills `table` from `world` (InterceptTable::update with SelfInterceptV13 and
+// PlayerIntercept). Implemented in goalie_intercept.cpp.
+void predict_intercepts(const GoalieWorld& world, InterceptTable* table);
+
+// --- Commands, in the server's units (what the .rcl logs) -------------------------------
+
+struct Command {
+  enum class Kind : uint8_t { kNone, kDash, kTurn, kCatch, kKick, kTackle };
+  Kind kind = Kind::kNone;
+  double p1 = 0.0;  // dash power, turn moment, catch direction, kick power, tackle direction
+  double p2 = 0.0;  // dash direction, kick direction
+};
+
+// PlayerAgent::doDash / doTurn through librcsc's ActionEffector: the client's clamping,
+// discretizing, stamina and speed conservation and rounding, so the result is the command
+// the server receives. `angle_deg` of do_turn is the wanted turn of the body.
+Command do_dash(const GoalieWorld& w, double power, double dir_deg);
+Command do_turn(const GoalieWorld& w, double angle_deg);
+
+// librcsc body actions. Each returns true and sets *out when it issues a command, false when
+// it has nothing to do (as their execute() does).
+bool body_go_to_point(const GoalieWorld& w, Vec2 point, double dist_thr, double max_dash_power,
+                      double dash_speed, int cycle, bool save_recovery, double dir_thr, Command* out);
+bool body_turn_to_angle(const GoalieWorld& w, double angle_deg, Command* out);
+bool body_turn_to_point(const GoalieWorld& w, Vec2 point, int cycle, Command* out);
+bool body_stop_dash(const GoalieWorld& w, bool save_recovery, Command* out);
+
+// Body_Intercept2009 (implemented in goalie_intercept.cpp).
+bool body_intercept(const GoalieWorld& w, const InterceptTable& table, bool save_recovery, Command* out);
+
+// Ball and player inertia helpers (librcsc inertia_n_step_point and friends).
+inline Vec2 ball_inertia_point(const GoalieWorld& w, int n) {
+  const double k = (1.0 - std::pow(kBallDecay, n)) / (1.0 - kBallDecay);
+  return w.ball_pos + w.ball_vel * k;
+}
+inline Vec2 self_inertia_point(const GoalieWorld& w, int n) {
+  const double k = (1.0 - std::pow(kPlayerDecay, n)) / (1.0 - kPlayerDecay);
+  return w.self.pos + w.self.vel * k;
+}
+inline Vec2 self_inertia_final_point(const GoalieWorld& w) {
+  return w.self.pos + w.self.vel * (1.0 / (1.0 - kPlayerDecay));
+}
+
+}  // namespace pamdp::hfo::agent2d
