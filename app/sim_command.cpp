@@ -1,11 +1,13 @@
 #include <cstdio>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "app/commands.hpp"
 #include "app/sim_options.hpp"
+#include "envs/hfo/goalie.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/state_io.hpp"
 
@@ -24,28 +26,70 @@ void print_row(int step, int status, float reward, std::span<const float> obs) {
   for (float v : obs) {
     std::printf(",%.9g", static_cast<double>(v));
   }
-  std::printf("\n");
+}
+
+// The goalie's columns: the command it sent in the step that produced the row (in the
+// server's units, as the real server's logs give them; empty on the first row and where a
+// command has no such parameter), then its state after that step.
+void print_goalie(const hfo::HfoEnv& env, bool first) {
+  const hfo::SoccerSim& sim = env.sim();
+  const auto& c = sim.last_goalie_command();
+  const auto kind = static_cast<hfo::GoalieCommand::Kind>(c.kind);
+  using K = hfo::GoalieCommand::Kind;
+  if (first) {
+    std::printf(",,,");
+  } else {
+    std::printf(",%s", hfo::goalie_command_name(kind));
+    if (kind == K::kNone) {
+      std::printf(",,");
+    } else if (kind == K::kDash || kind == K::kKick) {
+      std::printf(",%.9g,%.9g", c.p1, c.p2);
+    } else {
+      std::printf(",%.9g,", c.p1);
+    }
+  }
+  const hfo::PlayerState& g = sim.state().players[hfo::kGoalieIndex];
+  std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", g.pos.x, g.pos.y, g.vel.x, g.vel.y, g.body_deg);
 }
 
 void run_trace(const TraceOptions& o) {
   const hfo::InitialState init = hfo::load_state_json(o.init);
   const std::vector<hfo::ScriptedAction> actions = hfo::load_actions_csv(o.actions);
-  hfo::HfoEnv env(o.sim.resolved());
+  const hfo::SoccerSimConfig cfg = o.sim.resolved();
+  if (init.has_goalie && !cfg.goalie) {
+    throw std::runtime_error(o.init + ": has a \"goalie\" object but the simulator has no goalie: add --goalie");
+  }
+  hfo::HfoEnv env(cfg);
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
   std::vector<float> discard(obs.size());
   env.reset(o.seed, discard);  // seeds the noise stream
-  env.set_state(init.agent, init.ball, obs);
+  if (init.has_goalie) {
+    env.set_state(init.agent, init.ball, init.goalie, obs);
+  } else {
+    env.set_state(init.agent, init.ball, obs);
+  }
 
   std::printf("step,status,reward");
   for (size_t i = 0; i < obs.size(); ++i) {
     std::printf(",f%zu", i);
   }
+  if (cfg.goalie) {
+    std::printf(",g_cmd,g_p1,g_p2,g_x,g_y,g_vx,g_vy,g_body");
+  }
   std::printf("\n");
+  auto end_row = [&](bool first) {
+    if (cfg.goalie) {
+      print_goalie(env, first);
+    }
+    std::printf("\n");
+  };
   print_row(0, hfo::kInGame, 0.0F, obs);
+  end_row(true);
   int step = 0;
   for (const auto& a : actions) {
     const StepResult r = env.step({a.id, a.params}, obs);
     print_row(++step, r.status, r.reward, obs);
+    end_row(false);
     if (r.terminal()) {
       if (static_cast<size_t>(step) < actions.size()) {
         std::fprintf(stderr, "pamdp sim trace: episode ended (%s) after %d of %zu actions; the rest were not run\n",
@@ -64,9 +108,12 @@ void register_sim(CLI::App& app) {
   auto opts = std::make_shared<TraceOptions>();
   CLI::App* trace = sim->add_subcommand(
       "trace",
-      "replay an action script from a given state and print step,status,reward,f0..f57 (f0..f65 with --goalie) as CSV");
+      "replay an action script from a given state and print step,status,reward,f0..f57 as CSV (with --goalie: "
+      "f0..f65, then the goalie's command and state g_cmd,g_p1,g_p2,g_x,g_y,g_vx,g_vy,g_body)");
   trace
-      ->add_option("--init", opts->init, "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}}")
+      ->add_option("--init", opts->init,
+                   "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}, "
+                   "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch}}")
       ->required()
       ->check(CLI::ExistingFile);
   trace

@@ -13,54 +13,17 @@
 #include <unordered_map>
 #include <vector>
 
+#include "csv_rows.hpp"
 #include "envs/hfo/geometry.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 
 namespace pamdp::hfo {
 namespace {
 
-struct Row {
-  std::unordered_map<std::string, std::string> cells;
-  [[nodiscard]] double num(const std::string& key) const {
-    const auto it = cells.find(key);
-    if (it == cells.end() || it->second.empty()) {
-      return 0.0;
-    }
-    return std::stod(it->second);
-  }
-  [[nodiscard]] const std::string& str(const std::string& key) const { return cells.at(key); }
-};
+using Row = testing::CsvRow;
 
 std::vector<Row> load_rows(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<Row> rows;
-  if (!in) {
-    return rows;
-  }
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  {
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
-      header.push_back(cell);
-    }
-  }
-  while (std::getline(in, line)) {
-    if (line.empty()) {
-      continue;
-    }
-    Row r;
-    std::stringstream ss(line);
-    std::string cell;
-    size_t i = 0;
-    while (std::getline(ss, cell, ',') && i < header.size()) {
-      r.cells[header[i++]] = cell;
-    }
-    rows.push_back(std::move(r));
-  }
-  return rows;
+  return testing::load_csv_rows(path);
 }
 
 int status_code(const std::string& s) {

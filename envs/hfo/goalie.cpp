@@ -1,198 +1,587 @@
+// agent2d's goalie, from its rules (see goalie.hpp for the sources). Everything below works in
+// the goalie's own frame (goal at x = -52.5), as agent2d does; goalie_world() mirrors once.
 #include "envs/hfo/goalie.hpp"
 
 #include <algorithm>
-#include <array>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 
 namespace pamdp::hfo {
+thread_local char g_goalie_rule[512];  // DEBUG
 namespace {
+#define RULE(name) (std::strncat(g_goalie_rule, name " ", sizeof(g_goalie_rule) - std::strlen(g_goalie_rule) - 1))
 
-// Cycles of ball path the goalie looks ahead, and the speed below which it counts the ball as
-// stopped (it then rolls less than 2 mm more).
-constexpr int kHorizon = 40;
-constexpr double kBallAtRest = 1e-4;
-// Distance at which the goalie counts the ball as won at the end of a cycle: a little inside
-// the referee's 1.085 m (and the 1.2 m catch), as a margin for movement and kick noise.
-constexpr double kGoalieReach = 0.9;
-// The attacker's reach, a little generous: the client kickable distance 1.03.
-constexpr double kAttackerReach = 1.1;
-// Dashing straight is worth a turn first when the target lies this far off the body axis.
-constexpr double kTurnThresholdDeg = 22.5;
-// Guarding: how far out from the goal line the goalie stands on the bisector toward the ball,
-// as a fraction of the ball's distance along it, clamped (12 m stays inside the penalty
-// area); and how far in front of the goal line it stays at least. Tuned so that the scripted offense
-// scores about as often as agent2d's does against agent2d's goalie (docs/results.md).
-constexpr double kGuardFraction = 0.7;
-constexpr double kGuardMin = 1.0;
-constexpr double kGuardMax = 12.0;
-constexpr double kGuardMaxX = kPitchHalfLength - 0.5;
-// Position tolerance when guarding, and the ball bearing beyond which it turns to face it.
-constexpr double kGuardTolerance = 0.3;
-constexpr double kFaceBallDeg = 20.0;
+using agent2d::angle_norm;
+using agent2d::Command;
+using agent2d::GoalieWorld;
+using agent2d::InterceptTable;
 
-constexpr Vec2 kGoalCentre{kPitchHalfLength, 0.0};
+// ServerParam values agent2d reads (librcsc common/server_param.cpp defaults).
+constexpr double kOurPenaltyLineX = -kPitchHalfLength + 16.5;  // ourPenaltyAreaLineX(): -36
+constexpr double kPenaltyHalfWidth = kPenaltyBoxHalfWidth;     // penaltyAreaHalfWidth(): 20.16
+constexpr double kErrorValue = DBL_MAX;                        // Vector2D::ERROR_VALUE
 
-// Distance covered by n full forward dashes from rest (type 0, effort 1): 0.6, 1.44, ...
-constexpr std::array<double, kHorizon + 1> make_dash_reach() {
-  std::array<double, kHorizon + 1> reach{};
-  double v = 0.0;
-  double d = 0.0;
-  for (int n = 1; n <= kHorizon; ++n) {
-    v += kMaxDashPower * kDashPowerRate;
-    v = v > kPlayerSpeedMax ? kPlayerSpeedMax : v;
-    d += v;
-    v *= kPlayerDecay;
-    reach[n] = d;
+double th_deg(Vec2 v) {
+  return std::atan2(v.y, v.x) * kRadToDeg;
+}
+
+// librcsc Line2D: a x + b y + c = 0.
+struct Line {
+  double a;
+  double b;
+  double c;
+  static Line through(Vec2 p1, Vec2 p2) {
+    const double a = -(p2.y - p1.y);
+    const double b = p2.x - p1.x;
+    return {a, b, -a * p1.x - b * p1.y};
   }
-  return reach;
-}
-constexpr std::array<double, kHorizon + 1> kDashReach = make_dash_reach();
-
-Vec2 unit(Vec2 v) {
-  const double r = v.r();
-  return r > 0.0 ? v * (1.0 / r) : Vec2{1.0, 0.0};
-}
-
-bool in_penalty_area(Vec2 p) {
-  return p.x >= kPenaltyBoxX && p.x <= kPitchHalfLength && std::fabs(p.y) <= kPenaltyBoxHalfWidth;
-}
-
-// Bearing of `d` relative to the body, degrees in (-180, 180].
-double relative_deg(Vec2 d, double body_deg) {
-  return wrap_deg(std::atan2(d.y, d.x) * kRadToDeg - body_deg);
-}
-
-// A player as the reach estimate sees it: position and body direction.
-struct Mover {
-  Vec2 pos;
-  Vec2 body;  // unit vector of the body angle
-  explicit Mover(const PlayerState& p)
-      : pos(p.pos), body{std::cos(p.body_deg * kDegToRad), std::sin(p.body_deg * kDegToRad)} {}
+  static Line from(Vec2 origin, double dir_deg) {
+    const double a = -std::sin(dir_deg * kDegToRad);
+    const double b = std::cos(dir_deg * kDegToRad);
+    return {a, b, -a * origin.x - b * origin.y};
+  }
+  [[nodiscard]] double y_at(double x) const { return std::fabs(b) < 1e-10 ? kErrorValue : -(a * x + c) / b; }
+  [[nodiscard]] double dist(Vec2 p) const { return std::fabs((a * p.x + b * p.y + c) / std::sqrt(a * a + b * b)); }
+  // Line2D::intersection; an invalid point is (ERROR_VALUE, ERROR_VALUE).
+  [[nodiscard]] Vec2 intersection(const Line& o) const {
+    const double tmp = a * o.b - b * o.a;
+    if (std::fabs(tmp) < 1e-10) {
+      return {kErrorValue, kErrorValue};
+    }
+    return {(b * o.c - o.b * c) / tmp, (o.a * c - a * o.c) / tmp};
+  }
 };
 
-// Cycles `m` needs to get within `reach` of `target`: a turn if the target is off the body axis,
-// then full dashes. kHorizon + 1 if it cannot within the horizon.
-int cycles_to_reach(const Mover& m, Vec2 target, double reach) {
-  static const double kCosTurnThreshold = std::cos(kTurnThresholdDeg * kDegToRad);
-  const Vec2 d = target - m.pos;
-  const double dist = d.r();
-  const double need = dist - reach;
-  if (need <= 0.0) {
-    return 0;
-  }
-  const int turn = d.dot(m.body) < kCosTurnThreshold * dist ? 1 : 0;
-  const auto* it = std::lower_bound(kDashReach.begin() + 1, kDashReach.end(), need);
-  const int n = static_cast<int>(it - kDashReach.begin()) + turn;
-  return n <= kHorizon ? n : kHorizon + 1;
+bool valid(Vec2 p) {
+  return p.x != kErrorValue && p.y != kErrorValue;
 }
 
-// One command that brings `p` toward `target`, stopping there: turn first when the target is
-// far off the body axis, else dash in the nearest of the 45-degree directions with the power
-// that, with the player's decay, ends the motion at the target.
-GoalieCommand go_to(const PlayerState& p, Vec2 target) {
-  const Vec2 d = target - p.pos;
-  const double dist = d.r();
-  const double rel = relative_deg(d, p.body_deg);
-  if (dist > 1.0 && std::fabs(rel) > kTurnThresholdDeg) {
-    return {GoalieCommand::Kind::kTurn, 0.0, rel};
+struct Context {
+  const GoalieWorld& w;
+  const InterceptTable& t;
+  Command* out;
+};
+
+// --- Bhv_GoalieBasicMove -------------------------------------------------------------------
+
+Vec2 basic_target_point(const Context& c) {
+  const GoalieWorld& w = c.w;
+  constexpr double kBaseMoveX = -49.8;
+  constexpr double kDangerMoveX = -51.5;
+  int ball_reach_step = 0;
+  if (!w.exist_kickable_opponent) {
+    ball_reach_step = std::min(c.t.teammate_reach_cycle, c.t.opponent_reach_cycle);
   }
-  const double dash_dir = kDashAngleStep * std::nearbyint(rel / kDashAngleStep);
-  const double a = (p.body_deg + dash_dir) * kDegToRad;
-  const Vec2 u{std::cos(a), std::sin(a)};
-  // A push a moves the player a / (1 - decay) in all; the current velocity adds v / (1 - decay).
-  const double wanted = (d * (1.0 - kPlayerDecay) - p.vel).dot(u);
-  const double abs_dir = std::fabs(dash_dir);
-  const double rate = abs_dir <= 90.0
-                          ? kSideDashRate + (1.0 - kSideDashRate) * (1.0 - abs_dir / 90.0)
-                          : kBackDashRate - (kBackDashRate - kSideDashRate) * (1.0 - (abs_dir - 90.0) / 90.0);
-  const double power = clamp(wanted / (kDashPowerRate * p.effort * rate), 0.0, kMaxDashPower);
-  return {GoalieCommand::Kind::kDash, power, dash_dir};
+  const Vec2 base_pos = agent2d::ball_inertia_point(w, ball_reach_step);
+  if (base_pos.y > kGoalHalfWidth + 3.0) {
+    const double a = th_deg(Vec2{-kPitchHalfLength, kGoalHalfWidth} - base_pos);
+    if (-140.0 < a && a < -90.0) {
+      return {kDangerMoveX, kGoalHalfWidth + 0.001};
+    }
+  } else if (base_pos.y < -kGoalHalfWidth - 3.0) {
+    const double a = th_deg(Vec2{-kPitchHalfLength, -kGoalHalfWidth} - base_pos);
+    if (90.0 < a && a < 140.0) {
+      return {kDangerMoveX, -kGoalHalfWidth - 0.001};
+    }
+  }
+  if (base_pos.x < -kPitchHalfLength + 8.0 && std::fabs(base_pos.y) > kGoalHalfWidth + 2.0) {
+    return {kBaseMoveX, (base_pos.y < 0.0 ? -1.0 : 1.0) * (kGoalHalfWidth - 0.1)};
+  }
+  constexpr double kXBack = 7.0;
+  constexpr double kYBuf = 0.5;
+  int ball_pred_cycle = 5;
+  const Vec2 base_point{-kPitchHalfLength - kXBack, 0.0};
+  Vec2 ball_point = base_pos;
+  if (!w.exist_kickable_opponent) {
+    ball_pred_cycle = std::min(ball_pred_cycle, c.t.opponent_reach_cycle);
+    // inertia_n_step_point(base_pos, ball vel, n, ball_decay)
+    ball_point = base_pos + w.ball_vel * ((1.0 - std::pow(kBallDecay, ball_pred_cycle)) / (1.0 - kBallDecay));
+  }
+  if (ball_point.x < base_point.x + 0.1) {
+    ball_point.x = base_point.x + 0.1;
+  }
+  double move_y = Line::through(ball_point, base_point).y_at(kBaseMoveX);
+  move_y = std::min(move_y, kGoalHalfWidth - kYBuf);
+  move_y = std::max(move_y, -kGoalHalfWidth + kYBuf);
+  return {kBaseMoveX, move_y};
+}
+
+double basic_dash_power(const Context& c, Vec2 move_point) {
+  const GoalieWorld& w = c.w;
+  const double my_inc = kStaminaIncMax * w.self.recovery;
+  if (std::fabs(w.self.pos.x - move_point.x) > 3.0) {
+    return kMaxDashPower;
+  }
+  if (w.ball_pos.x > -30.0) {
+    return w.self.stamina < kStaminaMax * 0.9 ? my_inc * 0.5 : my_inc;
+  }
+  if (w.ball_pos.x > kOurPenaltyLineX) {
+    if (std::fabs(w.ball_pos.y) > 20.0) {
+      return my_inc;
+    }
+    if (w.ball_vel.x > 1.0) {
+      return my_inc * 0.5;
+    }
+    if (c.t.opponent_reach_cycle <= 3) {
+      return kMaxDashPower;
+    }
+    if (w.self.stamina < kStaminaMax * 0.7) {
+      return my_inc * 0.7;
+    }
+    return kMaxDashPower * 0.6;
+  }
+  if (std::fabs(w.ball_pos.y) < 15.0 || w.ball_pos.y * w.self.pos.y < 0.0) {
+    return kMaxDashPower;
+  }
+  return my_inc;
+}
+
+double dist_thr_of(const GoalieWorld& w, double rate) {
+  return std::max(0.5, w.ball_dist_from_self * rate);
+}
+
+// Bhv_GoalieBasicMove::doGoToPointLookBall in play_on: Bhv_GoToPointLookBall.
+void go_to_point_look_ball(const Context& c, Vec2 target, double dist_thr, double dash_power) {
+  agent2d::go_to_point_look_ball(c.w, target, dist_thr, dash_power, 0.7, c.out);
+}
+
+bool prepare_deep_cross(const Context& c, Vec2 move_point) {
+  RULE("prepare_deep_cross");
+  const GoalieWorld& w = c.w;
+  if (std::fabs(move_point.y) < kGoalHalfWidth - 0.8) {
+    return false;
+  }
+  if (std::fabs(th_deg(w.ball_pos - Vec2{-kPitchHalfLength, 0.0})) < 60.0) {
+    return false;
+  }
+  const double thr = dist_thr_of(w, 0.1);
+  if ((agent2d::self_inertia_final_point(w) - move_point).r() > thr) {
+    go_to_point_look_ball(c, move_point, thr, basic_dash_power(c, move_point));
+    return true;
+  }
+  agent2d::body_turn_to_angle(w, w.ball_pos.y < 0.0 ? 10.0 : -10.0, c.out);
+  return true;
+}
+
+bool stop_at_move_point(const Context& c, Vec2 move_point) {
+  RULE("stop_at_move_point");
+  const GoalieWorld& w = c.w;
+  const double thr = dist_thr_of(w, 0.1);
+  if ((w.self.pos - move_point).r() < thr) {
+    if ((agent2d::self_inertia_final_point(w) - move_point).r() < thr) {
+      return false;
+    }
+    // Body_StopDash may decide that no dash is worth it: then no body command goes out.
+    agent2d::body_stop_dash(w, true, c.out);
+    return true;
+  }
+  return false;
+}
+
+bool go_to_move_point(const Context& c, Vec2 move_point) {
+  RULE("go_to_move_point");
+  const GoalieWorld& w = c.w;
+  const double thr = dist_thr_of(w, 0.08);
+  const double y_diff = std::fabs(move_point.y - w.self.pos.y);
+  if (y_diff < thr) {
+    return false;
+  }
+  double dash_power = basic_dash_power(c, move_point);
+  if (std::fabs(std::fabs(w.self.body_deg) - 90.0) < 7.0) {
+    const double required = y_diff / (w.self.effort * kDashPowerRate);
+    dash_power = std::min(dash_power, required);
+    if (move_point.y > w.self.pos.y) {
+      if (w.self.body_deg < 0.0) {
+        dash_power = -dash_power;
+      }
+    } else if (w.self.body_deg > 0.0) {
+      dash_power = -dash_power;
+    }
+    *c.out = agent2d::do_dash(w, clamp(dash_power, kMinDashPower, kMaxDashPower), 0.0);
+  } else {
+    go_to_point_look_ball(c, move_point, thr, dash_power);
+  }
+  return true;
+}
+
+bool move_for_dangerous_state(const Context& c, Vec2 move_point) {
+  RULE("move_for_dangerous_state");
+  const GoalieWorld& w = c.w;
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  if (std::fabs(move_point.x - w.self.pos.x) > 0.5 && ball_next.x < -kPitchHalfLength + 11.0 &&
+      std::fabs(ball_next.y) < kGoalHalfWidth + 1.0) {
+    if (w.num_opponents > 0 && (w.opponents[0].pos - w.ball_pos).r() < 2.0) {
+      Vec2 block = w.opponents[0].pos;
+      block.x -= 2.5;
+      block.y = move_point.y;
+      if (w.self.pos.x < block.x) {
+        block.x = w.self.pos.x;
+      }
+      if (go_to_move_point(c, block)) {
+        return true;
+      }
+      go_to_point_look_ball(c, move_point, dist_thr_of(w, 0.1), kMaxDashPower);
+      return true;
+    }
+  }
+  return false;
+}
+
+bool correct_x(const Context& c, Vec2 move_point) {
+  RULE("correct_x");
+  const GoalieWorld& w = c.w;
+  constexpr double kXBuf = 0.5;
+  if (std::fabs(move_point.x - w.self.pos.x) < kXBuf) {
+    return false;
+  }
+  if ((!w.exist_kickable_opponent && c.t.opponent_reach_cycle >= 4) || w.ball_dist_from_self > 18.0) {
+    const double power = basic_dash_power(c, move_point);
+    if (!w.exist_kickable_opponent && w.ball_dist_from_self > 30.0) {
+      if (!agent2d::body_go_to_point(w, move_point, kXBuf, power, -1.0, 100, true, 15.0, c.out)) {
+        agent2d::body_turn_to_angle(w, w.self.body_deg > 0.0 ? 90.0 : -90.0, c.out);
+      }
+      return true;
+    }
+    go_to_point_look_ball(c, move_point, kXBuf, power);
+    return true;
+  }
+  return false;
+}
+
+bool correct_body_dir(const Context& c, Vec2 move_point, bool consider_opp) {
+  RULE("correct_body_dir");
+  const GoalieWorld& w = c.w;
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  const double target_angle = ball_next.y < 0.0 ? -90.0 : 90.0;
+  if (std::fabs(angle_norm(w.self.body_deg - target_angle)) < 5.0) {
+    return false;
+  }
+  if (std::fabs(th_deg(w.ball_pos - Vec2{-kPitchHalfLength, 0.0})) >= 60.0) {
+    return false;
+  }
+  const double opp_ball_dist = w.num_opponents == 0 ? 100.0 : (w.opponents[0].pos - w.ball_pos).r();
+  if (!consider_opp || opp_ball_dist > 7.0 || w.ball_dist_from_self > 20.0 ||
+      (std::fabs(move_point.y - w.self.pos.y) < 1.0 && !w.exist_kickable_opponent)) {
+    agent2d::body_turn_to_angle(w, target_angle, c.out);
+    return true;
+  }
+  return false;
+}
+
+bool basic_tackle(const Context& c);
+
+void basic_move(const Context& c) {
+  RULE("basic_move");
+  const Vec2 move_point = basic_target_point(c);
+  if (basic_tackle(c) || prepare_deep_cross(c, move_point) || stop_at_move_point(c, move_point) ||
+      move_for_dangerous_state(c, move_point) || correct_x(c, move_point) || correct_body_dir(c, move_point, true) ||
+      go_to_move_point(c, move_point) || correct_body_dir(c, move_point, false)) {
+    return;
+  }
+  *c.out = agent2d::do_turn(c.w, 0.0);
+}
+
+// --- Bhv_BasicTackle(0.8, 90) ---------------------------------------------------------------
+
+// SelfObject's tackle probability (librcsc self_object.cpp, updateBallInfo): the server's
+// tackle failure (ball in the body frame against tackle_dist, tackle_back_dist, tackle_width,
+// tackle_exponent).
+double tackle_probability(const GoalieWorld& w) {
+  const double a = (w.self.body_deg) * kDegToRad;
+  const Vec2 d = w.ball_pos - w.self.pos;
+  const double x = d.x * std::cos(a) + d.y * std::sin(a);
+  const double y = -d.x * std::sin(a) + d.y * std::cos(a);
+  const double dist = x > 0.0 ? kTackleDist : kTackleBackDist;
+  if (dist <= 0.0) {
+    return 0.0;
+  }
+  const double fail =
+      std::pow(std::fabs(x) / dist, kTackleExponent) + std::pow(std::fabs(y) / kTackleWidth, kTackleExponent);
+  return fail >= 1.0 ? 0.0 : std::max(0.0, 1.0 - fail);
+}
+
+bool basic_tackle(const Context& c) {
+  RULE("basic_tackle");
+  const GoalieWorld& w = c.w;
+  // In its own penalty area the goalie has no foul option (version 14 rule of
+  // Bhv_BasicTackle::execute), and outside it HFO's goalie never stands.
+  if (tackle_probability(w) < 0.8) {
+    return false;
+  }
+  const int self_min = c.t.self_reach_cycle;
+  const int opp_min = c.t.opponent_reach_cycle;
+  const Vec2 self_reach_point = agent2d::ball_inertia_point(w, self_min);
+  bool ball_into_goal = false;
+  if (self_reach_point.x < -kPitchHalfLength) {
+    // Ray2D from the ball along its velocity against the goal line.
+    const Line ball_line = Line::from(w.ball_pos, th_deg(w.ball_vel));
+    const Vec2 p = ball_line.intersection(Line::through({-kPitchHalfLength, 10.0}, {-kPitchHalfLength, -10.0}));
+    const bool ahead = valid(p) && (p - w.ball_pos).dot(w.ball_vel) >= 0.0;
+    ball_into_goal = ahead && std::fabs(p.y) < kGoalHalfWidth + 1.0;
+  }
+  const Vec2 their_goal{kPitchHalfLength, 0.0};
+  if (!(w.exist_kickable_opponent || ball_into_goal ||
+        (opp_min < self_min - 3 && opp_min < c.t.teammate_reach_cycle - 3) ||
+        (self_min >= 5 && (w.ball_pos - their_goal).r2() < 100.0 &&
+         std::fabs(angle_norm(th_deg(their_goal - w.self.pos) - w.self.body_deg)) < 45.0))) {
+    return false;
+  }
+  // Bhv_BasicTackle::executeV14 without a foul: the tackle direction whose resulting ball
+  // velocity points farthest from its own goal among the forward ones (10-degree steps).
+  const double ball_rel = std::fabs(angle_norm(w.ball_angle_from_self_deg - w.self.body_deg));
+  const double tackle_rate = kTacklePowerRate * (1.0 - 0.5 * ball_rel / 180.0);
+  const Vec2 our_goal{-kPitchHalfLength, 0.0};
+  Vec2 virtual_accel{};
+  if (w.exist_kickable_opponent) {
+    const Vec2 d = our_goal - w.ball_pos;
+    virtual_accel = d * (0.5 / d.r());
+  }
+  double best_angle = 0.0;
+  double best_speed = -1.0;
+  for (double a = -180.0; a < 180.0; a += 10.0) {
+    const double rel = angle_norm(a - w.self.body_deg);
+    double eff = kMaxBackTacklePower + (kMaxTacklePower - kMaxBackTacklePower) * (1.0 - std::fabs(rel) / 180.0);
+    eff *= tackle_rate;
+    Vec2 vel = w.ball_vel + polar(eff, a * kDegToRad) + virtual_accel;
+    const double speed = vel.r();
+    if (speed > kBallSpeedMax) {
+      vel *= kBallSpeedMax / speed;
+    }
+    if (std::fabs(th_deg(vel)) > 90.0) {
+      continue;
+    }
+    if (vel.r() > best_speed) {
+      best_speed = vel.r();
+      best_angle = a;
+    }
+  }
+  if (best_speed < 0.0) {
+    return false;
+  }
+  *c.out = {Command::Kind::kTackle, angle_norm(best_angle - w.self.body_deg), 0.0};
+  return true;
+}
+
+// --- Bhv_GoalieChaseBall -------------------------------------------------------------------
+
+void go_to_catch_point(const Context& c, Vec2 target) {
+  RULE("go_to_catch_point");
+  const GoalieWorld& w = c.w;
+  const Vec2 d = target - w.self.pos;
+  const double a = -w.self.body_deg * kDegToRad;
+  const Vec2 rel{d.x * std::cos(a) - d.y * std::sin(a), d.x * std::sin(a) + d.y * std::cos(a)};
+  const double rel_angle = th_deg(rel);
+  const double angle_buf = std::fabs(std::atan2(agent2d::kCatchableArea * 0.9, rel.r()) * kRadToDeg);
+  if (std::fabs(rel_angle) < angle_buf) {
+    *c.out = agent2d::do_dash(w, std::min(w.self.stamina + kExtraStamina, kMaxDashPower), 0.0);
+  } else if (std::fabs(rel_angle) > 180.0 - angle_buf) {
+    double power = kMinDashPower;
+    const double required = kMinDashPower < 0.0 ? kMinDashPower * -2.0 : kMinDashPower;
+    if (w.self.stamina + kExtraStamina < required) {
+      power = (w.self.stamina + kExtraStamina) * -0.5;
+      power = std::max(power, kMinDashPower);
+    }
+    *c.out = agent2d::do_dash(w, power, 0.0);
+  } else if (std::fabs(rel_angle) < 90.0) {
+    *c.out = agent2d::do_turn(w, rel_angle);
+  } else {
+    *c.out = agent2d::do_turn(w, angle_norm(rel_angle - 180.0));
+  }
+}
+
+bool ball_shoot_moving(const GoalieWorld& w) {
+  if (w.ball_dist_from_self > 30.0 || w.ball_pos.x > -34.5 || w.exist_kickable_opponent) {
+    return false;
+  }
+  if (std::fabs(w.ball_vel.x) < 0.1) {
+    return w.ball_pos.x < -46.0 && std::fabs(w.ball_pos.y) < kGoalHalfWidth + 2.0;
+  }
+  const Line ball_line = Line::from(w.ball_pos, th_deg(w.ball_vel));
+  const double y = ball_line.y_at(-kPitchHalfLength);
+  if (std::fabs(ball_line.b) > 0.1 && std::fabs(y) < kGoalHalfWidth + 2.0 && w.ball_pos.x < -40.0 &&
+      std::fabs(w.ball_pos.y) < 15.0) {
+    const Vec2 end_point = w.ball_pos + w.ball_vel * (1.0 / (1.0 - kBallDecay));
+    return w.ball_vel.r() > 0.5 && end_point.x < -kPitchHalfLength + 2.0;
+  }
+  return false;
+}
+
+bool ball_chase_situation(const Context& c) {
+  const GoalieWorld& w = c.w;
+  const int self_min = c.t.self_reach_cycle;
+  const int opp_min = c.t.opponent_reach_cycle;
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  if (ball_next.x < -kPitchHalfLength + 8.0 && std::fabs(ball_next.y) < kGoalHalfWidth + 3.0) {
+    if (w.ball_dist_from_self < 3.0 && self_min <= 3) {
+      return true;
+    }
+    return !(self_min > opp_min + 3 && opp_min < 7);
+  }
+  if (ball_shoot_moving(w) && self_min < opp_min) {
+    return true;
+  }
+  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, self_min);
+  const double pen_thr = std::max(1.0, w.ball_dist_from_self * 0.1 + 1.0);
+  if (std::fabs(my_int_pos.y) > kPenaltyHalfWidth - pen_thr || my_int_pos.x > kOurPenaltyLineX - pen_thr) {
+    return false;
+  }
+  if (opp_min <= self_min - 2) {
+    return false;
+  }
+  const double my_dist_to_catch = (w.self.pos - my_int_pos).r();
+  double opp_min_dist = 10000.0;
+  for (int i = 0; i < w.num_opponents; ++i) {
+    opp_min_dist = std::min(opp_min_dist, (w.opponents[i].pos - my_int_pos).r());
+  }
+  return opp_min_dist >= my_dist_to_catch - 2.0;
+}
+
+void chase_ball(const Context& c) {
+  RULE("chase_ball");
+  const GoalieWorld& w = c.w;
+  if (basic_tackle(c)) {
+    return;
+  }
+  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, c.t.self_reach_cycle);
+  const double pen_thr = std::max(1.0, w.ball_dist_from_self * 0.1 + 1.0);
+  const Line ball_line = Line::from(w.ball_pos, th_deg(w.ball_vel));
+  const Line defend_line = Line::through({w.self.pos.x, -10.0}, {w.self.pos.x, 10.0});
+  if (my_int_pos.x > -kPitchHalfLength - 1.0 && my_int_pos.x < kOurPenaltyLineX - pen_thr &&
+      std::fabs(my_int_pos.y) < kPenaltyHalfWidth - pen_thr) {
+    const bool save_recovery = ball_line.dist(w.self.pos) < agent2d::kCatchableArea;
+    agent2d::body_intercept(w, c.t, save_recovery, c.out);
+    return;
+  }
+  const int self_min = c.t.self_reach_cycle;
+  const int opp_min = c.t.opponent_reach_cycle;
+  Vec2 inter = ball_line.intersection(defend_line);
+  if (!valid(inter) || ball_line.dist(w.self.pos) < agent2d::kCatchableArea * 0.8 ||
+      std::fabs(inter.y) > kGoalHalfWidth + 3.0) {
+    if (!w.exist_kickable_opponent) {
+      if (self_min <= opp_min + 2 && my_int_pos.x > -kPitchHalfLength - 2.0 &&
+          my_int_pos.x < kOurPenaltyLineX - pen_thr && std::fabs(my_int_pos.y) < kPenaltyHalfWidth - pen_thr) {
+        if (agent2d::body_intercept(w, c.t, false, c.out)) {
+          return;
+        }
+      }
+      go_to_catch_point(c, w.ball_pos);
+      return;
+    }
+  }
+  if (std::fabs(inter.x) > kPitchHalfLength + agent2d::kCatchableArea ||
+      inter.x > kOurPenaltyLineX - agent2d::kCatchableArea ||
+      std::fabs(inter.y) > kPenaltyHalfWidth - agent2d::kCatchableArea) {
+    if (!agent2d::body_intercept(w, c.t, false, c.out)) {
+      basic_move(c);
+    }
+    return;
+  }
+  const Vec2 my_final = agent2d::self_inertia_final_point(w);
+  const double dist_thr = std::max(0.5, 0.2 + w.ball_dist_from_self * 0.1);
+  if ((my_final - inter).r() < dist_thr) {
+    agent2d::body_stop_dash(w, false, c.out);  // may send nothing
+    return;
+  }
+  if (w.ball_pos.x > -35.0) {
+    inter.y = w.ball_pos.y * inter.y < 0.0 ? 0.0 : inter.y * 0.5;
+  }
+  go_to_catch_point(c, inter);
+}
+
+// Our penalty area as RoleGoalie::execute shrinks it (Rect2D: left-top and size).
+bool in_catch_area(Vec2 p) {
+  const double left = -kPitchHalfLength;
+  const double top = -kPenaltyHalfWidth + 1.0;
+  return left <= p.x && p.x <= left + (16.5 - 1.0) && top <= p.y && p.y <= top + (2.0 * kPenaltyHalfWidth - 2.0);
 }
 
 }  // namespace
 
-GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
+agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
+  // rcssserver sends the right side every position mirrored through the centre.
+  auto mirror = [](Vec2 v) { return Vec2{-v.x, -v.y}; };
   const PlayerState& me = s.players[goalie];
-  const BallState& ball = s.ball;
-  const Vec2 to_ball = ball.pos - me.pos;
-
-  // 1. Catch.
-  if (me.catch_ban == 0 && in_penalty_area(ball.pos) && to_ball.r() < kCatchableAreaLength) {
-    return {GoalieCommand::Kind::kCatch, 0.0, relative_deg(to_ball, me.body_deg)};
-  }
-
-  // 2. Intercept. The nearest attacker is the opponent that matters.
-  const PlayerState* attacker = nullptr;
+  GoalieWorld w;
+  w.self.pos = mirror(me.pos);
+  w.self.vel = mirror(me.vel);
+  w.self.body_deg = angle_norm(me.body_deg + 180.0);
+  w.self.stamina = me.stamina;
+  w.self.effort = me.effort;
+  w.self.recovery = me.recovery;
+  w.self.capacity = me.capacity;
+  w.self.frozen = me.tackle_cycles > 0;
+  w.ball_pos = mirror(s.ball.pos);
+  w.ball_vel = mirror(s.ball.vel);
+  w.since_catch = me.since_catch;
   for (int i = 0; i < s.num_players; ++i) {
     const PlayerState& p = s.players[i];
-    if (p.team != me.team && (attacker == nullptr || (p.pos - ball.pos).r2() < (attacker->pos - ball.pos).r2())) {
-      attacker = &p;
-    }
-  }
-  const Mover keeper(me);
-  const Mover opponent(attacker != nullptr ? *attacker : me);
-  Vec2 bp = ball.pos;
-  Vec2 bv = ball.vel;
-  bool into_goal = false;
-  int attacker_cycles = kHorizon + 1;
-  for (int k = 1; k <= kHorizon; ++k) {
-    const Vec2 next = bp + bv;
-    if (next.x > kPitchHalfLength) {
-      const double t = (kPitchHalfLength - bp.x) / (next.x - bp.x);
-      into_goal = std::fabs(bp.y + t * (next.y - bp.y)) <= kGoalHalfWidth + kGoalPostRadius;
-      break;
-    }
-    bp = next;
-    bv *= kBallDecay;
-    if (bv.r2() < kBallAtRest * kBallAtRest) {
-      // The ball has (all but) stopped at bp: the first cycle each player can be there.
-      if (attacker != nullptr && attacker_cycles > kHorizon) {
-        attacker_cycles = std::max(k, cycles_to_reach(opponent, bp, kAttackerReach));
-      }
-      const int mine = std::max(k, cycles_to_reach(keeper, bp, kGoalieReach));
-      if (in_penalty_area(bp) && mine <= kHorizon && mine < attacker_cycles) {
-        return go_to(me, bp);
-      }
-      break;
-    }
-    if (attacker != nullptr && attacker_cycles > kHorizon && cycles_to_reach(opponent, bp, kAttackerReach) <= k) {
-      attacker_cycles = k;
-    }
-    if (!in_penalty_area(bp) || cycles_to_reach(keeper, bp, kGoalieReach) > k) {
+    if (p.team == me.team || w.num_opponents == GoalieWorld::kMaxOpponents) {
       continue;
     }
-    // First reachable point of the path: worth going if the attacker is not there first.
-    if (k < attacker_cycles) {
-      return go_to(me, bp);
-    }
-    break;
+    agent2d::PlayerView& o = w.opponents[w.num_opponents++];
+    o.pos = mirror(p.pos);
+    o.vel = mirror(p.vel);
+    o.body_deg = angle_norm(p.body_deg + 180.0);
+    o.tackling = p.tackle_cycles > 0;
   }
-  if (into_goal) {
-    // A shot the goalie cannot reach in time: the best it can do is the nearest point of the
-    // path to the goal line, which the search above ended at.
-    return go_to(me, bp);
-  }
+  std::sort(w.opponents.begin(), w.opponents.begin() + w.num_opponents,
+            [&](const agent2d::PlayerView& a, const agent2d::PlayerView& b) {
+              return (a.pos - w.ball_pos).r2() < (b.pos - w.ball_pos).r2();
+            });
+  w.finish();
+  return w;
+}
 
-  // 3. Guard: stand on the bisector of the angle the goal mouth makes at the ball, which
-  // leaves the same margin to both posts, at kGuardFraction of the way out toward the ball.
-  Vec2 target = kGoalCentre;
-  if (ball.pos.x < kPitchHalfLength - 0.5) {
-    const Vec2 to_top = unit(Vec2{kPitchHalfLength, -kGoalHalfWidth} - ball.pos);
-    const Vec2 to_bottom = unit(Vec2{kPitchHalfLength, kGoalHalfWidth} - ball.pos);
-    const Vec2 bisector = unit(to_top + to_bottom);
-    const double t = (kPitchHalfLength - ball.pos.x) / bisector.x;  // ball to the goal line
-    const double out = std::min(t, clamp(kGuardFraction * t, kGuardMin, kGuardMax));
-    target = ball.pos + bisector * (t - out);
+GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
+  const GoalieWorld w = goalie_world(s, goalie);
+  g_goalie_rule[0] = 0;
+  if (w.self.frozen) {
+    return {};  // librcsc refuses every body command while the tackle freezes the player
   }
-  target.x = std::min(target.x, kGuardMaxX);
-  if ((target - me.pos).r() > kGuardTolerance) {
-    return go_to(me, target);
+  // RoleGoalie::execute.
+  if (w.since_catch > kCatchBanCycles && w.ball_dist_from_self < agent2d::kCatchableArea - 0.05 &&
+      in_catch_area(w.ball_pos)) {
+    // ActionEffector::setCatch: the ball's direction plus the angle of the rectangle's diagonal.
+    const double diagonal = std::atan2(kCatchableAreaWidth * 0.5, kCatchableAreaLength) * kRadToDeg;
+    return {GoalieCommand::Kind::kCatch, angle_norm(w.ball_angle_from_self_deg - w.self.body_deg + diagonal), 0.0};
   }
-  const double ball_rel = relative_deg(to_ball, me.body_deg);
-  if (std::fabs(ball_rel) > kFaceBallDeg) {
-    return {GoalieCommand::Kind::kTurn, 0.0, ball_rel};
+  Command out;
+  if (w.self_kickable) {
+    // RoleGoalie::doKick calls Body_ClearBall. HFO's referee ends the episode before the
+    // ball comes this close, so this is reached only from a state set by hand; a full-power
+    // kick straight away from the goal stands in for the clearing kick there.
+    const double dir = angle_norm(th_deg(w.ball_pos - Vec2{-kPitchHalfLength, 0.0}) - w.self.body_deg);
+    return {GoalieCommand::Kind::kKick, kMaxKickPower, dir};
   }
-  return {};
+  InterceptTable table;
+  agent2d::predict_intercepts(w, &table);
+  const Context c{w, table, &out};
+  {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "self=%d opp=%d kick_opp=%d ", table.self_reach_cycle, table.opponent_reach_cycle,
+                  w.exist_kickable_opponent);
+    std::strncat(g_goalie_rule, buf, 200);
+  }
+  if (ball_chase_situation(c)) {
+    chase_ball(c);
+  } else {
+    basic_move(c);
+  }
+  return out;
+}
+
+const char* goalie_command_name(GoalieCommand::Kind kind) {
+  switch (kind) {
+    case GoalieCommand::Kind::kDash: return "DASH";
+    case GoalieCommand::Kind::kTurn: return "TURN";
+    case GoalieCommand::Kind::kCatch: return "CATCH";
+    case GoalieCommand::Kind::kKick: return "KICK";
+    case GoalieCommand::Kind::kTackle: return "TACKLE";
+    case GoalieCommand::Kind::kNone: return "NONE";
+  }
+  return "NONE";
 }
 
 }  // namespace pamdp::hfo

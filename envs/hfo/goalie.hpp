@@ -1,39 +1,43 @@
-// The hand-coded NPC goalie of the embedded simulator (1v1, SoccerSimConfig::goalie).
+// HFO's goalie in the embedded simulator: agent2d's keeper (HFO b8b2a1d `src/role_goalie.cpp`,
+// `bhv_goalie_basic_move.cpp`, `bhv_goalie_chase_ball.cpp`, `bhv_basic_tackle.cpp`) on
+// librcsc d222758, re-implemented from its rules (goalie_world.hpp has the world model and
+// the librcsc actions). It is checked one cycle at a time against the real server's goalie
+// (tests/hfo_goalie_real_data_test.cpp, docs/simulator.md).
 //
-// decide_goalie() is a pure function of the state at the start of a cycle: it reads the exact
-// positions and velocities (the goalie has full state, like the agent) and returns one body
-// command, which SoccerSim then executes with the same client and server handling as the
-// agent's commands (dash with 45-degree directions, stamina and effort, turn with inertia) or
-// as the goalie's catch. It draws no random numbers and allocates nothing.
+// decide_goalie() is a pure function of the state at the start of a cycle plus the memory the
+// real goalie keeps, which lives in the state (PlayerState::since_catch). It returns the
+// command the goalie's client sends to the server, in the server's units (dash power and
+// direction after librcsc's client adjustments, turn moment, catch direction relative to the
+// body), which SoccerSim then executes with the server's handling. It draws no random numbers
+// and allocates nothing.
 //
-// What it does, in order:
-//  1. catch: the ball is inside the penalty area, within the catchable length (1.2 m) and
-//     the catch ban is over -> catch toward the ball;
-//  2. intercept: it predicts the ball's path (no noise, decay 0.94) and finds the first cycle
-//     at which it can be within reach of the ball (turn, if needed, then full dashes); it goes
-//     there if the point is in its penalty area and either the ball is heading into the goal
-//     or it gets there before the attacker can;
-//  3. otherwise it guards: it stands between the ball and the goal, on the bisector of the
-//     angle the goal mouth makes at the ball, 70% of the way out toward the ball (at least
-//     1 m, at most 12 m from the goal line), and faces the ball.
-// It never kicks: the referee already ends the episode once the goalie is within the
-// kickable area of the ball (reference §5.2), so there is nothing left to clear.
+// What it does each cycle (role_goalie.cpp, RoleGoalie::execute):
+//  1. catch, when the catch ban is over (more than catch_ban_cycle = 5 cycles since its last
+//     catch), the ball is within catchableArea - 0.05 = 1.25 m and inside its penalty area
+//     shrunk by 1 m at the sides and the front;
+//  2. otherwise, when the ball is kickable (never in HFO play: the referee ends the episode
+//     first), a clearing kick;
+//  3. otherwise it chases the ball when Bhv_GoalieChaseBall::is_ball_chase_situation says so
+//     (intercepting with Body_Intercept2009 or going to the point where the ball's path
+//     crosses its line), and else it keeps its basic position (Bhv_GoalieBasicMove: on the
+//     line from the ball to a point 7 m behind the goal centre, at x = 2.7 m in front of the
+//     goal line, turning to face across the goal when there).
 #pragma once
 
-#include <cstdint>
-
+#include "envs/hfo/goalie_world.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 
 namespace pamdp::hfo {
 
-struct GoalieCommand {
-  enum class Kind : uint8_t { kNone, kDash, kTurn, kCatch };
-  Kind kind = Kind::kNone;
-  double power = 0.0;    // dash power
-  double dir_deg = 0.0;  // dash, turn or catch direction, relative to the body
-};
+using GoalieCommand = agent2d::Command;
+
+// The goalie's world model, mirrored into its own frame (goalie_world.hpp).
+agent2d::GoalieWorld goalie_world(const SoccerState& state, int goalie);
 
 // The goalie's command for this cycle; `goalie` indexes state.players.
 GoalieCommand decide_goalie(const SoccerState& state, int goalie);
+
+// The command's name as the server's log writes it (DASH, TURN, CATCH, KICK, TACKLE, NONE).
+const char* goalie_command_name(GoalieCommand::Kind kind);
 
 }  // namespace pamdp::hfo

@@ -18,6 +18,24 @@
 
 namespace pamdp::hfo::agent2d {
 
+// librcsc AngleDeg::normalize_angle: [-180, 180], keeping -180 as -180 (unlike wrap_deg).
+inline double angle_norm(double deg) {
+  if (deg < -360.0 || 360.0 < deg) {
+    deg = std::fmod(deg, 360.0);
+  }
+  if (deg < -180.0) {
+    deg += 360.0;
+  }
+  if (deg > 180.0) {
+    deg -= 360.0;
+  }
+  return deg;
+}
+
+// ServerParam::catchableArea(): the diagonal of the catchable rectangle, sqrt(1.2^2 + 0.5^2).
+inline const double kCatchableArea =
+    std::sqrt(kCatchableAreaLength * kCatchableAreaLength + 0.25 * kCatchableAreaWidth * kCatchableAreaWidth);
+
 // A player as the world model holds it (pos, vel as the server stores them: post-decay).
 struct PlayerView {
   Vec2 pos;
@@ -76,7 +94,7 @@ struct InterceptInfo {
 // librcsc InterceptTable: ball path cache, the goalie's own ways to the ball, and the
 // opponents' and teammates' reach cycles (1000 = cannot within the horizon).
 struct InterceptTable {
-  static constexpr int kMaxCycle = 30;                 // InterceptTable::MAX_CYCLE
+  static constexpr int kMaxCycle = 30;  // InterceptTable::MAX_CYCLE
   static constexpr int kMaxSelfCache = 2 * (kMaxCycle + 2);
   std::array<Vec2, kMaxCycle + 2> ball_cache{};
   int ball_cache_size = 0;
@@ -109,11 +127,19 @@ Command do_turn(const GoalieWorld& w, double angle_deg);
 
 // librcsc body actions. Each returns true and sets *out when it issues a command, false when
 // it has nothing to do (as their execute() does).
-bool body_go_to_point(const GoalieWorld& w, Vec2 point, double dist_thr, double max_dash_power,
-                      double dash_speed, int cycle, bool save_recovery, double dir_thr, Command* out);
+bool body_go_to_point(const GoalieWorld& w, Vec2 point, double dist_thr, double max_dash_power, double dash_speed,
+                      int cycle, bool save_recovery, double dir_thr, Command* out);
 bool body_turn_to_angle(const GoalieWorld& w, double angle_deg, Command* out);
 bool body_turn_to_point(const GoalieWorld& w, Vec2 point, int cycle, Command* out);
 bool body_stop_dash(const GoalieWorld& w, bool save_recovery, Command* out);
+
+// StaminaModel::getSafetyDashPower: the power that keeps stamina above the recovery threshold.
+double safety_dash_power(const GoalieWorld& w, double dash_power);
+// Bhv_NeckBodyToPoint (the body part): turn to `point` unless the neck alone can face it.
+bool neck_body_to_point(const GoalieWorld& w, Vec2 point, double angle_buf, Command* out);
+// Bhv_GoToPointLookBall.
+bool go_to_point_look_ball(const GoalieWorld& w, Vec2 target, double dist_thr, double dash_power,
+                           double back_power_rate, Command* out);
 
 // Body_Intercept2009 (implemented in goalie_intercept.cpp).
 bool body_intercept(const GoalieWorld& w, const InterceptTable& table, bool save_recovery, Command* out);

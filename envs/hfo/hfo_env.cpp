@@ -99,6 +99,16 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, std::spa
   begin_episode(obs);
 }
 
+void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, const PlayerState& goalie,
+                       std::span<float> obs) {
+  if (!sim_.config().goalie) {
+    misuse("set_state() with a goalie on an env without one");
+  }
+  sim_.set_state(agent, ball);
+  sim_.set_goalie(goalie);
+  begin_episode(obs);
+}
+
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
   if (action.params.size() < static_cast<size_t>(param::kCount)) {
     misuse("step(): the parameter vector must hold the 6 HFO parameters");

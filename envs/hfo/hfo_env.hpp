@@ -69,6 +69,8 @@ class HfoEnv final : public Env {
 
   // Starts an episode from an explicit state (tests, `pamdp sim trace`).
   void set_state(const PlayerState& agent, const BallState& ball, std::span<float> obs);
+  // The same with the goalie's state too (a 1v1 env only).
+  void set_state(const PlayerState& agent, const BallState& ball, const PlayerState& goalie, std::span<float> obs);
   [[nodiscard]] const SoccerSim& sim() const { return sim_; }
 
  private:

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
+#include "envs/hfo/client_effector.hpp"
 #include "envs/hfo/goalie.hpp"
 
 namespace pamdp::hfo {
@@ -20,21 +22,6 @@ constexpr double kPostSeparation = 1e-10;
 constexpr double kCollisionSeparation = 1e-10;
 // E1 trainer: a player "holds" the ball within 1.5 x the kickable area.
 constexpr double kTrainerHoldDist = 1.5 * (kKickableMargin + kPlayerSize + kBallSize);
-
-double round3(double x) {
-  return std::nearbyint(x * 1000.0) / 1000.0;
-}
-
-double dash_dir_rate(double dir_deg) {
-  const double a = std::fabs(dir_deg);
-  const double rate = a <= 90.0 ? kSideDashRate + (1.0 - kSideDashRate) * (1.0 - a / 90.0)
-                                : kBackDashRate - (kBackDashRate - kSideDashRate) * (1.0 - (a - 90.0) / 90.0);
-  return clamp(rate, 0.0, 1.0);
-}
-
-double discretize_dash_dir(double dir_deg) {
-  return kDashAngleStep * std::nearbyint(dir_deg / kDashAngleStep);
-}
 
 // Centre of the post in the same quadrant as p (the only post p can reach in one cycle).
 Vec2 nearest_post(Vec2 p) {
@@ -150,6 +137,17 @@ void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
   }
   player_accel_.fill(Vec2{});
   ball_accel_ = {};
+  last_goalie_command_ = {};
+}
+
+void SoccerSim::set_goalie(const PlayerState& goalie) {
+  PlayerState& g = state_.players[kGoalieIndex];
+  const Team team = g.team;
+  const bool is_goalie = g.goalie;
+  g = goalie;
+  g.team = team;
+  g.goalie = is_goalie;
+  g.body_deg = wrap_deg(goalie.body_deg);
 }
 
 bool SoccerSim::agent_kickable() const {
@@ -180,33 +178,20 @@ bool SoccerSim::dash_player(int i, double power, double dir_deg) {
   if (p.tackle_cycles > 0) {
     return false;
   }
-  // --- Client (librcsc): wrap, clamp, discretize, conserve stamina and speed, round. ---
-  double dir = discretize_dash_dir(wrap_deg(dir_deg));
-  power = clamp(power, kMinDashPower, kMaxDashPower);
-  bool back = power < 0.0;
-  const double need = back ? -2.0 * power : power;
-  if (p.stamina + kExtraStamina < need) {
-    power = back ? -(p.stamina + kExtraStamina) / 2.0 : p.stamina + kExtraStamina;
-  }
-  {
-    const double rate = dash_dir_rate(dir);
-    double acc = std::fabs(power * rate * p.effort * kDashPowerRate);
-    const double ang = (p.body_deg + dir + (back ? 180.0 : 0.0)) * kDegToRad;
-    const Vec2 unit{std::cos(ang), std::sin(ang)};
-    if ((p.vel + unit * acc).r2() > kPlayerSpeedMax * kPlayerSpeedMax + 1e-4 && rate * p.effort > 0.0) {
-      const double v_par = p.vel.dot(unit);
-      const double v_perp2 = std::max(0.0, p.vel.r2() - v_par * v_par);
-      acc = std::max(0.0, std::sqrt(std::max(0.0, kPlayerSpeedMax * kPlayerSpeedMax - v_perp2)) - v_par);
-      power = (back ? -acc : acc) / (kDashPowerRate * p.effort * rate);
-      power = clamp(power, kMinDashPower, kMaxDashPower);
-    }
-  }
-  power = round3(power);
+  // --- Client (librcsc ActionEffector::setDash). ---
+  const ClientDash c = client_dash(p.vel, p.body_deg, p.stamina, p.effort, power, dir_deg);
+  return server_dash(i, c.power, c.dir_deg);
+}
 
+bool SoccerSim::server_dash(int i, double power, double dir) {
+  PlayerState& p = state_.players[i];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
   // --- Server: clamp, discretize, consume stamina, push. ---
   power = clamp(power, kMinDashPower, kMaxDashPower);
   dir = discretize_dash_dir(clamp(dir, kMinMoment, kMaxMoment));
-  back = power < 0.0;
+  const bool back = power < 0.0;
   double spent = back ? -2.0 * power : power;
   spent = std::min(spent, p.stamina + kExtraStamina);
   p.stamina = std::max(0.0, p.stamina - spent);
@@ -221,10 +206,16 @@ bool SoccerSim::turn_player(int i, double dir_deg) {
   if (p.tackle_cycles > 0) {
     return false;
   }
+  // Client: HFO's Turn is the desired actual turn; librcsc pre-compensates inertia.
+  return server_turn(i, client_turn_moment(p.vel, dir_deg));
+}
+
+bool SoccerSim::server_turn(int i, double moment) {
+  PlayerState& p = state_.players[i];
+  if (p.tackle_cycles > 0) {
+    return false;
+  }
   const double inertia = 1.0 + kInertiaMoment * p.vel.r();
-  // Client: HFO's Turn is the desired actual turn; pre-compensate inertia, clamp, round.
-  double moment = round3(clamp(wrap_deg(dir_deg) * inertia, kMinMoment, kMaxMoment));
-  // Server.
   moment = clamp(moment, kMinMoment, kMaxMoment);
   if (config_.noise) {
     moment *= 1.0 + rng_.uniform(-kPlayerRand, kPlayerRand);
@@ -238,17 +229,24 @@ bool SoccerSim::kick_player(int i, double power, double dir_deg) {
   if (p.tackle_cycles > 0) {
     return false;
   }
-  const Vec2 to_ball = state_.ball.pos - p.pos;
-  const double dist = to_ball.r();
+  const double dist = (state_.ball.pos - p.pos).r();
   // Client gating: no command at all unless the client calls the ball kickable.
   if (dist > kClientKickableArea) {
     return false;
   }
   power = round3(clamp(power, 0.0, kMaxKickPower));
-  const double dir = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
   if (dist > kKickableArea) {
     return true;  // sent, but the server ignores it (cannot happen behind the client gate)
   }
+  return kick_player_server(i, power, dir_deg);
+}
+
+bool SoccerSim::kick_player_server(int i, double power, double dir_deg) {
+  const PlayerState& p = state_.players[i];
+  const Vec2 to_ball = state_.ball.pos - p.pos;
+  const double dist = to_ball.r();
+  power = clamp(power, 0.0, kMaxKickPower);
+  const double dir = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
   const double phi = std::fabs(wrap_rad(std::atan2(to_ball.y, to_ball.x) - p.body_deg * kDegToRad));
   const double gap = dist - kPlayerSize - kBallSize;
   const double eff = power * kKickPowerRate * (1.0 - 0.25 * phi / kPi - 0.25 * gap / kKickableMargin);
@@ -264,7 +262,11 @@ bool SoccerSim::kick_player(int i, double power, double dir_deg) {
 }
 
 bool SoccerSim::tackle(double dir_deg) {
-  PlayerState& p = state_.players[0];
+  return tackle_player(0, dir_deg);
+}
+
+bool SoccerSim::tackle_player(int i, double dir_deg) {
+  PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
   }
@@ -306,14 +308,12 @@ bool SoccerSim::goalie_catch(int player, double dir_deg) {
   if (!p.goalie || p.catch_ban > 0 || p.tackle_cycles > 0) {
     return false;
   }
-  // The server refuses a catch of a ball outside the goalie's penalty area.
-  const Vec2 b = state_.ball.pos;
-  if (b.x < kPenaltyBoxX || b.x > kPitchHalfLength || std::fabs(b.y) > kPenaltyBoxHalfWidth) {
-    return false;
-  }
+  // rcssserver refuses nothing for the ball's place: in HFO mode CatchRef::ballCaught returns
+  // before its penalty-area check (referee.cpp).
   p.catch_ban = kCatchBanCycles;
   // Ball in the frame of the catch direction: the catchable area is the rectangle
   // [0, l] x [-w/2, w/2] in front of the player's centre.
+  const Vec2 b = state_.ball.pos;
   const double a = (p.body_deg + clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment)) * kDegToRad;
   const Vec2 d = b - p.pos;
   const double along = d.x * std::cos(a) + d.y * std::sin(a);
@@ -323,18 +323,63 @@ bool SoccerSim::goalie_catch(int player, double dir_deg) {
   }
   // kCatchProbability is 1: no draw, so the noise stream does not depend on catches.
   static_assert(kCatchProbability == 1.0);
+  // Player::goalieCatch on success: the goalie moves toward the ball until they touch, faces
+  // it and stops; Stadium::ballCaught then resolves collisions at once. The ball keeps its
+  // velocity (HFO mode: no free kick).
+  // The same operations in the same order as the server, so that the touching distance
+  // rounds the same way: whether collisions() finds the ball touching decides between a ball
+  // that bounces off (and is captured) and one that flies on.
+  const double r = d.r();
+  if (r > 0.0) {
+    const double mag = r - (kBallSize + kPlayerSize);
+    const Vec2 step = d * (mag / r);
+    p.pos += step;
+    p.body_deg = wrap_deg(std::atan2(step.y, step.x) * kRadToDeg);
+  }
+  p.vel = {};
+  player_accel_[player] = {};
+  collide_objects();
   state_.ball_caught = true;
-  state_.ball.vel = {};
-  ball_accel_ = {};
   return true;
 }
 
+bool SoccerSim::command_as_received(int player, const char* kind, double p1, double p2) {
+  const std::string_view k(kind);
+  if (k == "DASH") {
+    return server_dash(player, p1, p2);
+  }
+  if (k == "TURN") {
+    return server_turn(player, p1);
+  }
+  if (k == "KICK") {
+    PlayerState& p = state_.players[player];
+    if (p.tackle_cycles > 0 || (state_.ball.pos - p.pos).r() > kKickableArea) {
+      return false;
+    }
+    return kick_player_server(player, p1, p2);
+  }
+  if (k == "TACKLE") {
+    return tackle_player(player, p1);
+  }
+  if (k == "CATCH") {
+    return goalie_catch(player, p1);
+  }
+  return k == "NONE";
+}
+
 void SoccerSim::play_goalie() {
+  PlayerState& g = state_.players[kGoalieIndex];
   const GoalieCommand c = decide_goalie(state_, kGoalieIndex);
+  last_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
   switch (c.kind) {
-    case GoalieCommand::Kind::kDash: dash_player(kGoalieIndex, c.power, c.dir_deg); break;
-    case GoalieCommand::Kind::kTurn: turn_player(kGoalieIndex, c.dir_deg); break;
-    case GoalieCommand::Kind::kCatch: goalie_catch(kGoalieIndex, c.dir_deg); break;
+    case GoalieCommand::Kind::kDash: server_dash(kGoalieIndex, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTurn: server_turn(kGoalieIndex, c.p1); break;
+    case GoalieCommand::Kind::kCatch:
+      g.since_catch = 0;
+      goalie_catch(kGoalieIndex, c.p1);
+      break;
+    case GoalieCommand::Kind::kKick: kick_player(kGoalieIndex, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTackle: tackle_player(kGoalieIndex, c.p1); break;
     case GoalieCommand::Kind::kNone: break;
   }
 }
@@ -425,10 +470,11 @@ void SoccerSim::collide_objects() {
       for (int b = a + 1; b < n; ++b) {
         const double reach = size[a] + size[b];
         Vec2 d = *pos[b] - *pos[a];
-        double dist = d.r();
-        if (dist >= reach) {
+        // Stadium::collisions compares squared distances.
+        if (d.r2() >= reach * reach) {
           continue;
         }
+        double dist = d.r();
         any = true;
         collided[a] = collided[b] = true;
         if (a == 0) {
@@ -505,6 +551,9 @@ int SoccerSim::step() {
     if (p.catch_ban > 0) {
       --p.catch_ban;
     }
+    if (p.goalie && p.since_catch < PlayerState::kNoCatchYet) {
+      ++p.since_catch;
+    }
     // Collision flags describe this cycle only.
     p.collided_ball = p.collided_player = p.collided_post = false;
   }
@@ -553,8 +602,9 @@ int SoccerSim::referee_server() {
     }
   }
   state_.defense_hold = defense_near ? state_.defense_hold + 1 : 0;
-  // A catch (2015) or the goalie within the kickable area (HEAD) ends it at once.
-  if (state_.ball_caught || goalie_near || state_.defense_hold >= 2) {
+  // The goalie within the kickable area ends it at once (HFORef::analyse); a catch alone does
+  // not: in HFO mode the ball flies on, and only a ball that ends within reach is captured.
+  if (goalie_near || state_.defense_hold >= 2) {
     return kCapturedByDefense;
   }
   if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {

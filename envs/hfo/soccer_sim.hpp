@@ -80,6 +80,10 @@ struct PlayerState {
   double capacity = kStaminaCapacity;
   int tackle_cycles = 0;  // > 0 while frozen after a tackle
   int catch_ban = 0;      // goalie: > 0 while a new catch is refused (catch_ban_cycle)
+  // Goalie's own memory (librcsc SelfObject::catchTime): cycles since its last catch command,
+  // kNoCatchYet when it has not sent one this episode.
+  int since_catch = kNoCatchYet;
+  static constexpr int kNoCatchYet = 1000;
   bool collided_ball = false;
   bool collided_player = false;
   bool collided_post = false;
@@ -103,7 +107,7 @@ struct SoccerState {
   Vec2 prev_ball;            // ball position at the previous referee check
   int defense_hold = 0;      // consecutive checks a defender was on the ball
   int trainer_hold = 0;      // E1: consecutive cycles one player held the ball
-  bool ball_caught = false;  // the goalie caught the ball this episode (CAPTURED_BY_DEFENSE)
+  bool ball_caught = false;  // the goalie caught the ball this episode (ends it under the E1 trainer)
 };
 
 class SoccerSim {
@@ -117,6 +121,8 @@ class SoccerSim {
   // Replaces the state (tests, traces). Referee counters restart at this state; with a goalie
   // configured, the goalie is put back at its start (kGoalieStart, at rest, full stamina).
   void set_state(const PlayerState& agent, const BallState& ball);
+  // Replaces the goalie's state after set_state (traces); its team and role are kept.
+  void set_goalie(const PlayerState& goalie);
   [[nodiscard]] const SoccerState& state() const { return state_; }
   SoccerState& mutable_state() { return state_; }
   [[nodiscard]] const PlayerState& agent() const { return state_.players[0]; }
@@ -130,12 +136,28 @@ class SoccerSim {
   bool tackle(double dir_deg);
   bool kick(double power, double dir_deg);
 
-  // The goalie's catch (rcssserver Player::goalieCatch with the defaults of geometry.hpp):
-  // refused unless `player` is a goalie, its catch ban is over and the ball is in the penalty
-  // area; sets the ban; succeeds if the ball centre lies in the catchable rectangle
-  // (kCatchableAreaLength along body + dir_deg, kCatchableAreaWidth across). A caught ball
-  // stops and the referee ends the episode with CAPTURED_BY_DEFENSE. Returns success.
+  // The goalie's catch (rcssserver Player::goalieCatch with the defaults of geometry.hpp, in
+  // HFO mode): refused unless `player` is a goalie whose catch ban is over; sets the ban;
+  // succeeds if the ball centre lies in the catchable rectangle (kCatchableAreaLength along
+  // body + dir_deg, kCatchableAreaWidth across). HFO gives no free kick and does not hold the
+  // ball: the server moves the goalie toward the ball until they touch (ball_size +
+  // player_size from it), turns it to face the ball and stops it, and the ball flies on; the
+  // referee ends the episode only once the ball is within the goalie's kickable area.
+  // Returns success.
   bool goalie_catch(int player, double dir_deg);
+
+  // The command the goalie sent in the last step(), in the server's units (traces).
+  struct GoalieCommandLog {
+    uint8_t kind = 0;  // agent2d::Command::Kind
+    double p1 = 0.0;
+    double p2 = 0.0;
+  };
+  [[nodiscard]] const GoalieCommandLog& last_goalie_command() const { return last_goalie_command_; }
+
+  // A body command exactly as the server received it from `player`'s client (recorded logs,
+  // the goalie): DASH power dir, TURN moment, KICK power dir, TACKLE dir, CATCH dir; no client
+  // processing. Returns false if the server refuses it.
+  bool command_as_received(int player, const char* kind, double p1, double p2);
 
   // Advances one server cycle (movement, collisions, referee, stamina) and returns the status.
   int step();
@@ -147,6 +169,10 @@ class SoccerSim {
   bool dash_player(int i, double power, double dir_deg);
   bool turn_player(int i, double dir_deg);
   bool kick_player(int i, double power, double dir_deg);
+  bool kick_player_server(int i, double power, double dir_deg);
+  bool server_dash(int i, double power, double dir_deg);
+  bool server_turn(int i, double moment);
+  bool tackle_player(int i, double dir_deg);
   void play_goalie();
   void move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max, double speed_max,
                    double rand, bool* hit_post);
@@ -162,6 +188,7 @@ class SoccerSim {
   Vec2 ball_accel_;
   Rng rng_;
   bool first_episode_ = true;
+  GoalieCommandLog last_goalie_command_;
 };
 
 }  // namespace pamdp::hfo

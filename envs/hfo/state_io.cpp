@@ -1,6 +1,8 @@
 #include "envs/hfo/state_io.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -64,7 +66,7 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       !j["ball"].is_object()) {
     throw std::runtime_error(src + ": expected an object with \"agent\" and \"ball\" objects");
   }
-  reject_unknown(j, "", {"agent", "ball"}, src);
+  reject_unknown(j, "", {"agent", "ball", "goalie"}, src);
   const auto& a = j["agent"];
   const auto& b = j["ball"];
   reject_unknown(a, "agent", {"x", "y", "vx", "vy", "body_deg", "stamina"}, src);
@@ -79,6 +81,26 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
   }
   s.ball.pos = {number(b, "ball", "x", src, {}), number(b, "ball", "y", src, {})};
   s.ball.vel = {number(b, "ball", "vx", src, 0.0), number(b, "ball", "vy", src, 0.0)};
+  if (j.contains("goalie")) {
+    const auto& g = j["goalie"];
+    if (!g.is_object()) {
+      throw std::runtime_error(src + ": \"goalie\" must be an object");
+    }
+    reject_unknown(g, "goalie", {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch"}, src);
+    s.has_goalie = true;
+    s.goalie.pos = {number(g, "goalie", "x", src, kGoalieStart.x), number(g, "goalie", "y", src, kGoalieStart.y)};
+    s.goalie.vel = {number(g, "goalie", "vx", src, 0.0), number(g, "goalie", "vy", src, 0.0)};
+    s.goalie.body_deg = number(g, "goalie", "body_deg", src, kGoalieStartBodyDeg);
+    s.goalie.stamina = number(g, "goalie", "stamina", src, kStaminaMax);
+    if (s.goalie.stamina < 0.0 || s.goalie.stamina > kStaminaMax) {
+      throw std::runtime_error(src + ": goalie.stamina must be within [0, 8000]");
+    }
+    const double since = number(g, "goalie", "since_catch", src, PlayerState::kNoCatchYet);
+    if (since < 0.0 || since != std::floor(since)) {
+      throw std::runtime_error(src + ": goalie.since_catch must be a whole number of cycles >= 0");
+    }
+    s.goalie.since_catch = static_cast<int>(std::min(since, static_cast<double>(PlayerState::kNoCatchYet)));
+  }
   return s;
 }
 

@@ -1,7 +1,10 @@
 // Reading states and action scripts for `pamdp sim trace` and tests.
 //
-// STATE.json: {"agent": {"x", "y", "vx", "vy", "body_deg", "stamina"}, "ball": {"x", "y", "vx", "vy"}}
+// STATE.json: {"agent": {"x", "y", "vx", "vy", "body_deg", "stamina"}, "ball": {"x", "y", "vx", "vy"},
+//              "goalie": {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch"}}
 // (velocities are the observed, post-decay ones; stamina defaults to 8000, velocities to 0).
+// "goalie" is optional; each of its keys missing takes its value at a reset (52.5, 0, at rest,
+// body 180, stamina 8000, no catch yet); since_catch counts the cycles since its last catch.
 // ACTIONS.csv: one action per row: DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir;
 // blank lines and lines starting with '#' are skipped.
 // Both throw std::runtime_error naming the file, line and problem.
@@ -18,6 +21,8 @@ namespace pamdp::hfo {
 struct InitialState {
   PlayerState agent;
   BallState ball;
+  bool has_goalie = false;
+  PlayerState goalie;  // when has_goalie
 };
 
 InitialState parse_state_json(const std::string& text, const std::string& source_name);
