@@ -294,6 +294,58 @@ struct BadInvocation {
   std::vector<std::string> message_names;  // substrings the error message must contain
 };
 
+// `sim trace --goalie` sets the goalie from STATE.json and reports its command and state per
+// step. Row 3 of the real goalie transitions (tests/data): the real goalie caught (direction
+// 88.7726 from the body) and was moved to (49.2903, 5.7541) facing 156.152 degrees.
+TEST(Cli, SimTraceSetsAndReportsTheGoalie) {
+  const TempFile state(".json",
+                       R"({"agent": {"x": 40.745, "y": 7.0847, "vx": 0.3374, "vy": -0.0712, "body_deg": -11.456,
+                           "stamina": 6315},
+                           "ball": {"x": 48.9381, "y": 5.9098, "vx": 1.9668, "vy": -0.276},
+                           "goalie": {"x": 49.9714, "y": 5.453, "vx": 0, "vy": 0.1344, "body_deg": 90,
+                                      "stamina": 7935}})");
+  const TempFile actions(".csv", "DASH,100,0\n");
+  const RunResult r =
+      run_pamdp("sim trace --no-noise --goalie --init " + quoted(state.path()) + " --actions " + quoted(actions.path()),
+                Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::istringstream in(r.output);
+  std::string header;
+  std::string first;
+  std::string second;
+  std::getline(in, header);
+  std::getline(in, first);
+  std::getline(in, second);
+  EXPECT_NE(header.find(",f65,g_cmd,g_p1,g_p2,g_x,g_y,g_vx,g_vy,g_body"), std::string::npos) << header;
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream ss(line);
+    std::string c;
+    while (std::getline(ss, c, ',')) {
+      out.push_back(c);
+    }
+    if (!line.empty() && line.back() == ',') {
+      out.emplace_back();
+    }
+    return out;
+  };
+  const std::vector<std::string> a = cells(first);
+  const std::vector<std::string> b = cells(second);
+  ASSERT_EQ(a.size(), 3U + 66U + 8U) << first;
+  ASSERT_EQ(b.size(), a.size()) << second;
+  const size_t g = 3 + 66;
+  EXPECT_EQ(a[g], "") << "no command on the first row";
+  EXPECT_NEAR(std::stod(a[g + 3]), 49.9714, 1e-9);
+  EXPECT_NEAR(std::stod(a[g + 4]), 5.453, 1e-9);
+  EXPECT_EQ(b[1], "IN_GAME");
+  EXPECT_EQ(b[g], "CATCH");
+  EXPECT_NEAR(std::stod(b[g + 1]), 88.7726, 1e-2);
+  EXPECT_EQ(b[g + 2], "") << "a catch has one parameter";
+  EXPECT_NEAR(std::stod(b[g + 3]), 49.2903, 2e-4);
+  EXPECT_NEAR(std::stod(b[g + 4]), 5.7541, 2e-4);
+  EXPECT_NEAR(std::stod(b[g + 7]), 156.152, 1e-2);
+}
+
 // Test names and failure messages show the case's name, not its bytes.
 void PrintTo(const BadInvocation& c, std::ostream* os) {
   *os << c.name;
@@ -433,6 +485,14 @@ INSTANTIATE_TEST_SUITE_P(
                        true,
                        "{\"agent\": {\"x\": \"one\", \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}}",
                        {"agent.x"}},
+        MalformedInput{"StateGoalieUnknownKey",
+                       true,
+                       "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"z\": 0}}",
+                       {"goalie.z"}},
+        MalformedInput{"StateGoalieWithoutGoalieFlag",
+                       true,
+                       "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"x\": 50}}",
+                       {"goalie", "--goalie"}},
         MalformedInput{"ActionsUnknownAction", false, "DASH,100,0\n# comment\nJUMP,1\n", {":3:", "JUMP"}},
         MalformedInput{"ActionsWrongArity", false, "DASH,100,0\n\nTURN,10\nKICK,100\n", {":4:", "KICK,power,dir"}},
         MalformedInput{"ActionsNotANumber", false, "DASH,fast,0\n", {":1:", "fast"}}),

@@ -109,10 +109,17 @@ void SoccerSim::reset_episode() {
   }
   first_episode_ = false;
 
+  // HFO's reset places the goalie at (52.5, 0) at rest with full stamina but leaves its body
+  // as it was (HFORef::resetField places players; the body angle is not touched).
+  const double goalie_body = state_.players[kGoalieIndex].body_deg;
+  const bool carry_goalie = config_.goalie;  // the constructor's set_state gave it 180 to start
   PlayerState fresh;
   fresh.pos = {ax, ay};
   fresh.body_deg = body;
   set_state(fresh, BallState{{bx, by}, {0.0, 0.0}});
+  if (carry_goalie) {
+    state_.players[kGoalieIndex].body_deg = goalie_body;
+  }
 }
 
 void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
@@ -138,6 +145,7 @@ void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
   player_accel_.fill(Vec2{});
   ball_accel_ = {};
   last_goalie_command_ = {};
+  goalie_sensed_ = false;
 }
 
 void SoccerSim::set_goalie(const PlayerState& goalie) {
@@ -162,14 +170,17 @@ Vec2 SoccerSim::noise_vector(double max_radius) {
 }
 
 bool SoccerSim::dash(double power, double dir_deg) {
+  sense_goalie();
   return dash_player(0, power, dir_deg);
 }
 
 bool SoccerSim::turn(double dir_deg) {
+  sense_goalie();
   return turn_player(0, dir_deg);
 }
 
 bool SoccerSim::kick(double power, double dir_deg) {
+  sense_goalie();
   return kick_player(0, power, dir_deg);
 }
 
@@ -262,6 +273,7 @@ bool SoccerSim::kick_player_server(int i, double power, double dir_deg) {
 }
 
 bool SoccerSim::tackle(double dir_deg) {
+  sense_goalie();
   return tackle_player(0, dir_deg);
 }
 
@@ -344,6 +356,7 @@ bool SoccerSim::goalie_catch(int player, double dir_deg) {
 }
 
 bool SoccerSim::command_as_received(int player, const char* kind, double p1, double p2) {
+  sense_goalie();
   const std::string_view k(kind);
   if (k == "DASH") {
     return server_dash(player, p1, p2);
@@ -367,10 +380,22 @@ bool SoccerSim::command_as_received(int player, const char* kind, double p1, dou
   return k == "NONE";
 }
 
-void SoccerSim::play_goalie() {
-  PlayerState& g = state_.players[kGoalieIndex];
+void SoccerSim::sense_goalie() {
+  if (!config_.goalie || goalie_sensed_) {
+    return;
+  }
   const GoalieCommand c = decide_goalie(state_, kGoalieIndex);
-  last_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
+  pending_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
+  goalie_sensed_ = true;
+}
+
+void SoccerSim::play_goalie() {
+  sense_goalie();
+  goalie_sensed_ = false;
+  PlayerState& g = state_.players[kGoalieIndex];
+  last_goalie_command_ = pending_goalie_command_;
+  const GoalieCommand c{static_cast<GoalieCommand::Kind>(pending_goalie_command_.kind), pending_goalie_command_.p1,
+                        pending_goalie_command_.p2};
   switch (c.kind) {
     case GoalieCommand::Kind::kDash: server_dash(kGoalieIndex, c.p1, c.p2); break;
     case GoalieCommand::Kind::kTurn: server_turn(kGoalieIndex, c.p1); break;

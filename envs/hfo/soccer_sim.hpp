@@ -173,6 +173,9 @@ class SoccerSim {
   bool server_dash(int i, double power, double dir_deg);
   bool server_turn(int i, double moment);
   bool tackle_player(int i, double dir_deg);
+  // The goalie senses the cycle's state before any command of the cycle changes it (a turn
+  // takes effect when the server receives it): decided once, at the first command or step().
+  void sense_goalie();
   void play_goalie();
   void move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max, double speed_max,
                    double rand, bool* hit_post);
@@ -189,6 +192,8 @@ class SoccerSim {
   Rng rng_;
   bool first_episode_ = true;
   GoalieCommandLog last_goalie_command_;
+  GoalieCommandLog pending_goalie_command_;
+  bool goalie_sensed_ = false;
 };
 
 }  // namespace pamdp::hfo
