@@ -57,16 +57,19 @@ struct EnvFacts {
     action_list = list;
   }
 
-  [[nodiscard]] int check_id(long long id, const std::string& where) const {
+  // `env` is the env's index in a batch, -1 for a single action (messages are built only on failure).
+  [[nodiscard]] int check_id(long long id, int env = -1) const {
     if (id < 0 || id >= space.num_actions()) {
-      throw py::value_error(where + " " + std::to_string(id) + " is not an action id (valid: " + action_list + ")");
+      throw py::value_error((env < 0 ? std::string("action") : "actions[0][" + std::to_string(env) + "] =") + " " +
+                            std::to_string(id) + " is not an action id (valid: " + action_list + ")");
     }
     return static_cast<int>(id);
   }
-  void check_finite(int id, const float* shared, const std::string& where) const {
+  void check_finite(int id, const float* shared, int env = -1) const {
     for (int i : space.actions[static_cast<size_t>(id)].param_indices) {
       if (!std::isfinite(shared[i])) {
-        throw py::value_error(where + ": parameter " + space.params[static_cast<size_t>(i)].name + " of " +
+        throw py::value_error((env < 0 ? std::string("action") : "actions of env " + std::to_string(env)) +
+                              ": parameter " + space.params[static_cast<size_t>(i)].name + " of " +
                               space.actions[static_cast<size_t>(id)].name + " is " + std::to_string(shared[i]) +
                               "; parameters must be finite");
       }
@@ -133,7 +136,7 @@ int read_action(py::handle action, const EnvFacts& f, std::vector<float>& shared
   if (seq.size() != 2) {
     throw py::value_error("action must be a pair (id, params), got " + std::to_string(seq.size()) + " items");
   }
-  const int id = f.check_id(read_integer(seq[0], "action[0], the discrete action id,"), "action");
+  const int id = f.check_id(read_integer(seq[0], "action[0], the discrete action id,"));
   const py::object params = seq[1];
   const std::vector<int>& owned = f.space.actions[static_cast<size_t>(id)].param_indices;
   if (py::isinstance<py::array>(params)) {
@@ -158,7 +161,7 @@ int read_action(py::handle action, const EnvFacts& f, std::vector<float>& shared
     throw py::type_error("action[1] must be " + f.params_help() + "; got " + type_name(params) +
                          (py::isinstance<py::sequence>(params) ? " of length " + std::to_string(py::len(params)) : ""));
   }
-  f.check_finite(id, shared.data(), "action");
+  f.check_finite(id, shared.data());
   return id;
 }
 
@@ -184,7 +187,7 @@ void read_actions(py::handle action, const EnvFacts& f, int n, std::vector<int>&
   }
   const auto np = static_cast<size_t>(f.space.num_params());
   for (int i = 0; i < n; ++i) {
-    ids[static_cast<size_t>(i)] = f.check_id(id_array.data()[i], "actions[0][" + std::to_string(i) + "] =");
+    ids[static_cast<size_t>(i)] = f.check_id(id_array.data()[i], i);
   }
   const py::object params = seq[1];
   if (py::isinstance<py::array>(params)) {
@@ -223,8 +226,7 @@ void read_actions(py::handle action, const EnvFacts& f, int n, std::vector<int>&
                          std::to_string(n) + "); got " + type_name(params));
   }
   for (int i = 0; i < n; ++i) {
-    f.check_finite(ids[static_cast<size_t>(i)], shared.data() + static_cast<size_t>(i) * np,
-                   "actions of env " + std::to_string(i));
+    f.check_finite(ids[static_cast<size_t>(i)], shared.data() + static_cast<size_t>(i) * np, i);
   }
 }
 
@@ -335,7 +337,8 @@ class PyVectorEnv {
     terminated_ = py::array_t<bool>(num_envs);
     truncated_ = py::array_t<bool>(num_envs);
     status_ = py::array_t<int32_t>(num_envs);
-    if (mode == AutoReset::kSameStep) {
+    same_step_ = mode == AutoReset::kSameStep;
+    if (same_step_) {
       final_obs_ = py::array_t<float>({num_envs, obs});
       has_final_ = py::array_t<bool>(num_envs);
       std::fill_n(final_obs_.mutable_data(), final_obs_.size(), 0.0F);
@@ -396,7 +399,7 @@ class PyVectorEnv {
                     {status_.mutable_data(), n},
                     {},
                     {}};
-    if (has_final_) {
+    if (same_step_) {
       b.final_obs = {final_obs_.mutable_data(), rows};
       b.has_final = {reinterpret_cast<uint8_t*>(has_final_.mutable_data()), n};
     }
@@ -409,7 +412,7 @@ class PyVectorEnv {
   [[nodiscard]] py::dict info() const {
     py::dict d;
     d["status"] = out(status_);
-    if (has_final_) {
+    if (same_step_) {
       d["final_obs"] = out(final_obs_);
       d["_final_obs"] = out(has_final_);
     }
@@ -425,7 +428,8 @@ class PyVectorEnv {
   py::array_t<bool> terminated_;
   py::array_t<bool> truncated_;
   py::array_t<int32_t> status_;
-  py::array_t<float> final_obs_;
+  bool same_step_ = false;
+  py::array_t<float> final_obs_;  // same_step only (a default py::array_t is an empty array, not null)
   py::array_t<bool> has_final_;
   std::vector<int> ids_;
   std::vector<float> shared_;

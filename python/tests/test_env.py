@@ -183,6 +183,14 @@ class VectorEnvTest(unittest.TestCase):
         self.assertIs(out[0], obs)
         flat = np.zeros((8, 6), np.float32)
         vec.step((ids, flat))  # one flat (N, num_params) array works too
+        self.assertEqual(set(out[4]), {"status"})  # next_step: no final_obs
+        # Large batches in both modes, made and dropped (a buffer overrun would show here).
+        for mode in ("next_step", "same_step", "next_step"):
+            big = pamdp.make_vec("hfo-1v1", num_envs=300, num_threads=3, autoreset_mode=mode)
+            big.reset(seed=2)
+            for _ in range(120):
+                big.step(big.action_space.sample())
+            del big
         # The first reset without a seed seeds env i with i.
         fresh = pamdp.make_vec("reach_stop", num_envs=3)
         obs, _ = fresh.reset()
