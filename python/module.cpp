@@ -618,7 +618,8 @@ PYBIND11_MODULE(_pamdp, m) {
                              [](const PyVectorEnv& v) { return v.vec().env(0).max_episode_steps(); })
       .def_property_readonly("actions",
                              [](const PyVectorEnv& v) { return describe_actions(v.vec().env(0).action_space()); })
-      .def_property_readonly("outcomes", [](const PyVectorEnv& v) { return describe_outcomes(v.vec().env(0)); });
+      .def_property_readonly("outcomes", [](const PyVectorEnv& v) { return describe_outcomes(v.vec().env(0)); })
+      .def_property_readonly("success_status", [](const PyVectorEnv& v) { return v.vec().env(0).success_status(); });
 
   py::class_<PyPolicy>(m, "Policy", py::dynamic_attr())
       .def(py::init([](const std::string& path, bool explore, std::optional<double> epsilon, py::handle seed,
