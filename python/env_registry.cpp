@@ -127,6 +127,10 @@ std::string env_toml(const app::EnvConfig& config) {
   return app::to_toml(c);
 }
 
+bool fresh_env_per_seed(const app::EnvConfig& config) {
+  return config.name != "hfo-server";
+}
+
 float observation_bound(const app::EnvConfig& config) {
   // HFO's features are normalized to [-1, 1] (hfo-reference.md §3); the toy task states its own.
   return config.name == "reach_stop" ? toy::ReachStopEnv::kObservationBound : 1.0F;

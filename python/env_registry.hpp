@@ -43,6 +43,12 @@ std::unique_ptr<Env> build_env(const app::EnvConfig& config);
 std::string id_of(const app::EnvConfig& config);
 std::string env_toml(const app::EnvConfig& config);
 
+// Whether a seeded reset should start from a freshly built env, so that the seed alone decides
+// the episode as Gymnasium expects (HFO carries the body angle from episode to episode with
+// env.body_at_reset = carry; Env::reset(seed) promises the same episode only on a fresh env).
+// False for hfo-server, whose connection a rebuild would drop (the server's own --seed rules).
+bool fresh_env_per_seed(const app::EnvConfig& config);
+
 // A bound on every |observation value| of the env `config` describes.
 float observation_bound(const app::EnvConfig& config);
 

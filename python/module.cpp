@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -269,7 +270,11 @@ class PyEnv {
     if (seed.is_none()) {
       env_->reset(out);
     } else {
-      env_->reset(read_seed(seed), out);
+      const uint64_t s = read_seed(seed);
+      if (fresh_env_per_seed(config_)) {
+        env_ = build_env(config_);  // the seed alone decides the episode
+      }
+      env_->reset(s, out);
     }
     needs_reset_ = false;
     return py::make_tuple(std::move(obs), info(0));
@@ -331,7 +336,11 @@ class PyVectorEnv {
     }
     facts_.emplace(*envs[0]);
     const int obs = facts_->obs_size;
-    vec_ = std::make_unique<VectorEnv>(std::move(envs), num_threads, mode, facts_->timeout_status);
+    std::function<std::unique_ptr<Env>()> rebuild;
+    if (fresh_env_per_seed(config_)) {
+      rebuild = [config = config_] { return build_env(config); };
+    }
+    vec_ = std::make_unique<VectorEnv>(std::move(envs), num_threads, mode, facts_->timeout_status, rebuild);
     obs_ = py::array_t<float>({num_envs, obs});
     reward_ = py::array_t<float>(num_envs);
     terminated_ = py::array_t<bool>(num_envs);

@@ -5,11 +5,13 @@
 
 namespace pamdp::python {
 
-VectorEnv::VectorEnv(std::vector<std::unique_ptr<Env>> envs, int num_threads, AutoReset mode, int timeout_status)
+VectorEnv::VectorEnv(std::vector<std::unique_ptr<Env>> envs, int num_threads, AutoReset mode, int timeout_status,
+                     std::function<std::unique_ptr<Env>()> rebuild)
     : envs_(std::move(envs)),
       num_threads_(std::clamp(num_threads, 1, std::max(1, static_cast<int>(envs_.size())))),
       mode_(mode),
       timeout_status_(timeout_status),
+      rebuild_(std::move(rebuild)),
       obs_size_(envs_.empty() ? 0 : envs_[0]->observation_size()),
       num_params_(envs_.empty() ? 0 : envs_[0]->action_space().num_params()),
       needs_reset_(envs_.size(), 1),
@@ -79,6 +81,11 @@ void VectorEnv::worker(int index) {
 
 void VectorEnv::reset(std::span<const uint64_t> seeds, const VectorBuffers& out) {
   out_ = out;
+  if (rebuild_ && !seeds.empty()) {
+    for (auto& env : envs_) {
+      env = rebuild_();
+    }
+  }
   const auto obs = static_cast<size_t>(obs_size_);
   const std::function<void(int, int)> job = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {

@@ -41,8 +41,10 @@ struct VectorBuffers {
 
 class VectorEnv {
  public:
-  // `timeout_status` is the status that counts as truncation (time limit), -1 if none.
-  VectorEnv(std::vector<std::unique_ptr<Env>> envs, int num_threads, AutoReset mode, int timeout_status);
+  // `timeout_status` is the status that counts as truncation (time limit), -1 if none. `rebuild`,
+  // when given, makes a fresh env for every seeded reset (see fresh_env_per_seed()).
+  VectorEnv(std::vector<std::unique_ptr<Env>> envs, int num_threads, AutoReset mode, int timeout_status,
+            std::function<std::unique_ptr<Env>()> rebuild = {});
   VectorEnv(const VectorEnv&) = delete;
   VectorEnv& operator=(const VectorEnv&) = delete;
   ~VectorEnv();
@@ -52,7 +54,8 @@ class VectorEnv {
   [[nodiscard]] int observation_size() const { return obs_size_; }
   [[nodiscard]] const Env& env(int i) const { return *envs_[static_cast<size_t>(i)]; }
 
-  // Resets every env: env i with seeds[i], or continuing its own stream when `seeds` is empty.
+  // Resets every env: env i with seeds[i] (a fresh env first, with `rebuild`), or continuing its
+  // own stream when `seeds` is empty.
   void reset(std::span<const uint64_t> seeds, const VectorBuffers& out);
   // One step of every env: env i takes action ids[i] with parameter row i of `params`
   // (N x num_params). Ids must be valid (the binding checks them).
@@ -67,6 +70,7 @@ class VectorEnv {
   int num_threads_;
   AutoReset mode_;
   int timeout_status_;
+  std::function<std::unique_ptr<Env>()> rebuild_;
   int obs_size_;
   int num_params_;
   std::vector<uint8_t> needs_reset_;
