@@ -107,8 +107,10 @@ class Env(_pamdp.Env):
 
     @property
     def options(self) -> dict:
-        """The env's settings (the config file's [env] table, defaults included)."""
-        return tomllib.loads(self.config_toml)["env"]
+        """The env's settings that make() takes, defaults included: make(env.env_id, **env.options)
+        builds the same env."""
+        table = tomllib.loads(self.config_toml)["env"]
+        return {k: table[k] for k in _pamdp.option_names(self.env_id)}
 
     def render(self):
         return None
@@ -190,8 +192,7 @@ class Policy(_pamdp.Policy):
     def make_env(self) -> Env:
         """The env the checkpoint was trained on, with its settings."""
         table = tomllib.loads(self.config_toml)["env"]
-        names = _pamdp.option_names(self.env_id)
-        return make(self.env_id, **{k: table[k] for k in names if k in table})
+        return make(self.env_id, **{k: table[k] for k in _pamdp.option_names(self.env_id)})
 
     def __repr__(self):
         return f"pamdp.Policy(env '{self.env_id}', {self.updates} updates, actor {self.actor})"

@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import unittest
 
 import numpy as np
@@ -22,21 +23,35 @@ CASES = [  # (checkpoint, episodes, seed): few episodes, so that the test takes 
 
 
 class CheckpointFromPython(unittest.TestCase):
+    def check_against_pamdp_eval(self, path, episodes, seed):
+        out = subprocess.run([PAMDP, "eval", "--checkpoint", path, "--episodes", str(episodes), "--seed", str(seed),
+                              "--json"], check=True, capture_output=True, text=True)
+        cpp = json.loads(out.stdout.strip().splitlines()[-1])
+        py = pamdp.evaluate(pamdp.load_policy(path), episodes=episodes, seed=seed)
+        self.assertEqual(py["episodes"], cpp["episodes"])
+        self.assertEqual(py["goal_rate"], cpp["goal_rate"])
+        self.assertEqual(py["avg_steps_to_goal"], cpp["avg_steps_to_goal"])
+        self.assertEqual(py["avg_steps"], cpp["avg_steps"])
+        self.assertAlmostEqual(py["avg_return"], cpp["avg_return"], places=9)
+        self.assertEqual(py["outcomes"], cpp["outcomes"])
+        self.assertGreater(py["goal_rate"], 0.5)
+
     def test_eval_row_equals_pamdp_eval(self):
         for path, episodes, seed in CASES:
             with self.subTest(checkpoint=path):
-                full = os.path.join(SOURCE, path)
-                out = subprocess.run([PAMDP, "eval", "--checkpoint", full, "--episodes", str(episodes), "--seed",
-                                      str(seed), "--json"], check=True, capture_output=True, text=True)
-                cpp = json.loads(out.stdout.strip().splitlines()[-1])
-                py = pamdp.evaluate(pamdp.load_policy(full), episodes=episodes, seed=seed)
-                self.assertEqual(py["episodes"], cpp["episodes"])
-                self.assertEqual(py["goal_rate"], cpp["goal_rate"])
-                self.assertEqual(py["avg_steps_to_goal"], cpp["avg_steps_to_goal"])
-                self.assertEqual(py["avg_steps"], cpp["avg_steps"])
-                self.assertAlmostEqual(py["avg_return"], cpp["avg_return"], places=9)
-                self.assertEqual(py["outcomes"], cpp["outcomes"])
-                self.assertGreater(py["goal_rate"], 0.5)
+                self.check_against_pamdp_eval(os.path.join(SOURCE, path), episodes, seed)
+
+    def test_toy_task_checkpoint(self):
+        # A fresh reach_stop run (under a second) and its checkpoint, read back from Python.
+        with tempfile.TemporaryDirectory() as run:
+            subprocess.run([PAMDP, "train", "--config", os.path.join(SOURCE, "deploy/configs/reach_stop.toml"),
+                            "--run-dir", run, "--seed", "3"], check=True, capture_output=True)
+            path = os.path.join(run, "checkpoint.ckpt")
+            self.check_against_pamdp_eval(path, 200, 5)
+            policy = pamdp.load_policy(path)
+            self.assertEqual(policy.env_id, "reach_stop")
+            ids, params = policy(np.zeros((3, 3), np.float32))
+            self.assertEqual([p.shape for p in params], [(3, 1), (3, 0)])
 
     def test_batch_and_exploration(self):
         full = os.path.join(SOURCE, CASES[0][0])
