@@ -89,6 +89,16 @@ struct EnvFacts {
   std::string action_list;
 };
 
+// `h` as a C-ordered float32 array (converting lists and other real dtypes), or a null array when
+// it cannot be one. Complex values are refused rather than silently cut to their real part.
+FloatArray float_array(py::handle h) {
+  if (py::isinstance<py::array>(h) && py::reinterpret_borrow<py::array>(h).dtype().kind() == 'c') {
+    throw py::type_error("action parameters must be real numbers, got dtype " +
+                         std::string(py::str(py::reinterpret_borrow<py::array>(h).dtype())));
+  }
+  return FloatArray::ensure(h);
+}
+
 long long read_integer(py::handle h, const std::string& what) {
   if (PyBool_Check(h.ptr()) || PyIndex_Check(h.ptr()) == 0) {
     throw py::type_error(what + " must be an int, got " + type_name(h));
@@ -141,7 +151,7 @@ int read_action(py::handle action, const EnvFacts& f, std::vector<float>& shared
   const py::object params = seq[1];
   const std::vector<int>& owned = f.space.actions[static_cast<size_t>(id)].param_indices;
   if (py::isinstance<py::array>(params)) {
-    const auto a = FloatArray::ensure(params);
+    const auto a = float_array(params);
     if (!a || a.ndim() != 1 || a.size() != f.space.num_params()) {
       throw py::value_error("action[1] as one array must hold all " + std::to_string(f.space.num_params()) +
                             " parameters (shape (" + std::to_string(f.space.num_params()) + ",))");
@@ -149,7 +159,7 @@ int read_action(py::handle action, const EnvFacts& f, std::vector<float>& shared
     std::memcpy(shared.data(), a.data(), shared.size() * sizeof(float));
   } else if ((py::isinstance<py::tuple>(params) || py::isinstance<py::list>(params)) &&
              py::len(params) == static_cast<size_t>(f.space.num_actions())) {
-    const auto mine = FloatArray::ensure(py::reinterpret_borrow<py::sequence>(params)[static_cast<size_t>(id)]);
+    const auto mine = float_array(py::reinterpret_borrow<py::sequence>(params)[static_cast<size_t>(id)]);
     if (!mine || mine.size() != static_cast<py::ssize_t>(owned.size()) || mine.ndim() > 1) {
       throw py::value_error("action[1][" + std::to_string(id) + "], the parameters of " +
                             f.space.actions[static_cast<size_t>(id)].name + ", must be a float array of shape (" +
@@ -192,7 +202,7 @@ void read_actions(py::handle action, const EnvFacts& f, int n, std::vector<int>&
   }
   const py::object params = seq[1];
   if (py::isinstance<py::array>(params)) {
-    const auto a = FloatArray::ensure(params);
+    const auto a = float_array(params);
     if (!a || a.ndim() != 2 || a.shape(0) != n || a.shape(1) != f.space.num_params()) {
       throw py::value_error("actions[1] as one array must have shape (" + std::to_string(n) + ", " +
                             std::to_string(np) + ")");
@@ -205,7 +215,7 @@ void read_actions(py::handle action, const EnvFacts& f, int n, std::vector<int>&
     arrays.reserve(static_cast<size_t>(f.space.num_actions()));
     for (int a = 0; a < f.space.num_actions(); ++a) {
       const size_t k = f.space.actions[static_cast<size_t>(a)].param_indices.size();
-      auto arr = FloatArray::ensure(per_action[static_cast<size_t>(a)]);
+      auto arr = float_array(per_action[static_cast<size_t>(a)]);
       if (!arr || arr.ndim() != 2 || arr.shape(0) != n || arr.shape(1) != static_cast<py::ssize_t>(k)) {
         throw py::value_error("actions[1][" + std::to_string(a) + "], the parameters of " +
                               f.space.actions[static_cast<size_t>(a)].name + ", must be a float array of shape (" +

@@ -265,6 +265,24 @@ class CallerErrors(unittest.TestCase):
         self.assertRaisesWith(ValueError, "must hold all 6 parameters", env.step, (0, np.zeros(5, np.float32)))
         env.step(good)  # the env is still usable after every refused call
 
+    def test_garbage_never_crashes(self):
+        env = pamdp.make("hfo-1v1")
+        vec = pamdp.make_vec("hfo-1v1", num_envs=3)
+        env.reset(seed=1)
+        vec.reset(seed=1)
+        junk = [None, "kick", b"x", 1.5, {}, {"id": 1}, [], [[]], (None, None), ("0", "1"), (0, "abc"),
+                (0, np.array(["a", "b"])), (0, np.zeros((2, 3), np.float32)), (0, [None] * 4), (2**70, ()),
+                (np.uint64(2**63), ()), (0, np.zeros(10**6, np.float32)), (0, [np.zeros(2)] * 3),
+                (0, np.array([object()] * 6)), (np.array([0]), np.zeros((1, 6))), (0, (1, 2, 3, 4)),
+                (np.zeros(3, np.int64), [np.zeros((3, 2)), None, None, None]), (np.zeros((3, 1), np.int64), ()),
+                (np.zeros(3, np.int64), np.zeros((3, 6), np.complex64)), (True, ())]
+        for action in junk:
+            for target in (env, vec):
+                with self.assertRaises((TypeError, ValueError, OverflowError), msg=repr(action)):
+                    target.step(action)
+        env.step(env.action_space.sample())
+        vec.step(vec.action_space.sample())
+
     def test_vector_env(self):
         vec = pamdp.make_vec("hfo-1v0", num_envs=4)
         ids, params = vec.action_space.sample()
