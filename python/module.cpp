@@ -388,12 +388,12 @@ class PyVectorEnv {
     }
     seeded_ = true;
     vec_->reset(seeds, buffers());
-    stepped_ = true;
+    was_reset_ = true;
     return py::make_tuple(out(obs_), info());
   }
 
   py::tuple step(py::handle action) {
-    if (!stepped_) {
+    if (!was_reset_) {
       throw std::logic_error("vector env: step() before reset(); call reset() first");
     }
     read_actions(action, *facts_, vec_->num_envs(), ids_, shared_);
@@ -453,7 +453,7 @@ class PyVectorEnv {
   std::vector<int> ids_;
   std::vector<float> shared_;
   bool seeded_ = false;
-  bool stepped_ = false;
+  bool was_reset_ = false;
 };
 
 // A checkpoint's actor as a batch policy: the greedy action `pamdp eval` plays (the actor copy
