@@ -137,12 +137,6 @@ class Tuple(Space):
             space.seed(int(child.generate_state(1)[0]))
         return [seed]
 
-    @property
-    def np_random(self) -> np.random.Generator:
-        if self._np_random is None:
-            self.seed()
-        return self._np_random
-
     def sample(self) -> tuple:
         if self._np_random is None:
             self.seed()
