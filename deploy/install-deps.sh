@@ -19,6 +19,7 @@ packages=(
   gnuplot-nox              # pamdp plot (learning-curve PNGs)
   prometheus               # the test that scrapes a running cluster with a real Prometheus
   clang-format             # tests/run.sh checks formatting
+  python3-dev python3-pybind11 python3-numpy  # the Python module pamdp (python/) and its tests
 )
 
 missing=()

@@ -1,0 +1,139 @@
+#include "python/env_registry.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "app/env_factory.hpp"
+#include "envs/toy/reach_stop.hpp"
+
+namespace pamdp::python {
+namespace {
+
+struct Entry {
+  EnvId id;
+  std::string name;                  // env.name
+  std::vector<std::string> fixed;    // env.* assignments the id makes ("goalie=true")
+  std::vector<std::string> options;  // the env.* keys a user may set
+};
+
+const std::vector<std::string> kHfoOptions{"body_at_reset", "goalie", "max_steps",      "noise",
+                                           "referee",       "start",  "untouched_limit"};
+const std::vector<std::string> kHfoFixedGoalie{"body_at_reset", "max_steps", "noise",
+                                               "referee",       "start",     "untouched_limit"};
+// The keys server_config() in app/env_factory.hpp reads.
+const std::vector<std::string> kServerOptions{"goalie",      "max_steps",   "server_config_dir", "server_encoding",
+                                              "server_host", "server_port", "server_team"};
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> kEntries{
+      {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
+       "hfo",
+       {"goalie=false"},
+       kHfoFixedGoalie},
+      {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
+       "hfo",
+       {"goalie=true"},
+       kHfoFixedGoalie},
+      {{"hfo", "embedded Half Field Offense, goalie chosen by the goalie option"}, "hfo", {}, kHfoOptions},
+      {{"reach_stop", "toy task: reach the target on a line, then STOP (3 features)"}, "reach_stop", {}, {}},
+      {{"hfo-server", "the real HFO server through its C++ client (a build with -DHFO_ROOT)"},
+       "hfo-server",
+       {},
+       kServerOptions},
+  };
+  return kEntries;
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) {
+    out += (out.empty() ? "" : ", ") + n;
+  }
+  return out.empty() ? "none" : out;
+}
+
+const Entry& find(const std::string& id) {
+  for (const Entry& e : entries()) {
+    if (e.id.id == id) {
+      return e;
+    }
+  }
+  std::vector<std::string> ids;
+  for (const Entry& e : entries()) {
+    ids.push_back(e.id.id);
+  }
+  throw std::invalid_argument("pamdp: unknown env '" + id + "' (valid: " + join(ids) + ")");
+}
+
+}  // namespace
+
+const std::vector<EnvId>& env_ids() {
+  static const std::vector<EnvId> kIds = [] {
+    std::vector<EnvId> ids;
+    for (const Entry& e : entries()) {
+      ids.push_back(e.id);
+    }
+    return ids;
+  }();
+  return kIds;
+}
+
+std::vector<std::string> option_names(const std::string& id) {
+  std::vector<std::string> names = find(id).options;
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+app::EnvConfig resolve_env(const std::string& id, const std::vector<std::pair<std::string, std::string>>& options) {
+  const Entry& e = find(id);
+  const std::string source = "pamdp.make('" + id + "')";
+  std::vector<std::string> sets{"env.name=\"" + e.name + "\""};
+  for (const std::string& f : e.fixed) {
+    sets.push_back("env." + f);
+  }
+  for (const auto& [key, value] : options) {
+    if (std::find(e.options.begin(), e.options.end(), key) == e.options.end()) {
+      for (const std::string& f : e.fixed) {
+        if (f.rfind(key + "=", 0) == 0) {
+          throw std::invalid_argument(source + ": '" + key + "' is fixed by the id ('" + f +
+                                      "'); make('hfo', goalie=...) chooses it");
+        }
+      }
+      throw std::invalid_argument(source + ": unknown option '" + key + "' (valid: " + join(option_names(id)) + ")");
+    }
+    sets.push_back("env." + key + "=" + value);
+  }
+  try {
+    return app::parse_experiment_config("", source, sets).env;
+  } catch (const std::runtime_error& err) {
+    throw std::invalid_argument(err.what());
+  }
+}
+
+std::unique_ptr<Env> build_env(const app::EnvConfig& config) {
+  return app::make_env(config);
+}
+
+std::string id_of(const app::EnvConfig& config) {
+  if (config.name == "hfo") {
+    return config.hfo.goalie ? "hfo-1v1" : "hfo-1v0";
+  }
+  return config.name;
+}
+
+std::string env_toml(const app::EnvConfig& config) {
+  app::ExperimentConfig c;
+  c.env = config;
+  return app::to_toml(c);
+}
+
+bool fresh_env_per_seed(const app::EnvConfig& config) {
+  return config.name != "hfo-server";
+}
+
+float observation_bound(const app::EnvConfig& config) {
+  // HFO's features are normalized to [-1, 1] (hfo-reference.md §3); the toy task states its own.
+  return config.name == "reach_stop" ? toy::ReachStopEnv::kObservationBound : 1.0F;
+}
+
+}  // namespace pamdp::python

@@ -1,0 +1,267 @@
+"""pamdp from Python: the embedded HFO simulator and the toy tasks as Gymnasium-style envs, a
+vector env stepped in C++, and trained agents.
+
+    import pamdp
+    env = pamdp.make("hfo-1v0")                  # or "hfo-1v1" (the goalie), "reach_stop", ...
+    obs, info = env.reset(seed=1)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    info["outcome"]                              # "IN_GAME", "GOAL", "OUT_OF_BOUNDS", ...
+
+Actions (MP-DQN's convention for parameterized action spaces): a pair (id, params) where id is
+the discrete action (HFO: 0 DASH, 1 TURN, 2 TACKLE, 3 KICK) and params is a tuple with one
+float32 array per discrete action holding that action's parameters (HFO: DASH (power, dir),
+TURN (dir,), TACKLE (dir,), KICK (power, dir)); only params[id] is read. params may also be
+one flat array of every parameter in the env's shared order (HFO: dash_power, dash_dir,
+turn_dir, tackle_dir, kick_power, kick_dir), the layout of a P-DQN or PA-DDPG actor's output.
+action_space is Tuple(Discrete(n), Tuple(Box per action)); parameters outside the bounds are
+clamped by the env, as the real HFO does.
+
+Episodes end with terminated (a terminal outcome: GOAL, OUT_OF_BOUNDS, CAPTURED_BY_DEFENSE) or
+truncated (OUT_OF_TIME, the time limit); info["outcome"] names it and info["status"] gives
+its code. Env options are keyword arguments named as the config file's env.* keys
+(pamdp.make("hfo-1v0", noise=False, start="hfo")), validated the same way.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+import tomllib
+
+import numpy as np
+
+from . import _pamdp
+from . import spaces
+
+__all__ = ["Env", "VectorEnv", "Policy", "make", "make_vec", "load_policy", "evaluate", "env_ids", "spaces"]
+
+
+def env_ids() -> dict:
+    """Every env id make() accepts, with a line on each."""
+    return dict(_pamdp.env_ids())
+
+
+def _check_id(env_id) -> None:
+    if not isinstance(env_id, str):
+        raise TypeError(f"env id must be a str such as 'hfo-1v0', got {type(env_id).__name__}")
+
+
+def _toml_value(env_id: str, key: str, value, default) -> str:
+    """`value` for option `key` as TOML text, checked against the type of its default."""
+
+    def wrong(kind: str):
+        return TypeError(f"pamdp.make('{env_id}'): option '{key}' must be {kind}, got {type(value).__name__}")
+
+    if isinstance(default, bool):
+        if not isinstance(value, (bool, np.bool_)):
+            raise wrong("a bool")
+        return "true" if value else "false"
+    if isinstance(default, int):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise wrong("an int")
+        return str(int(value))
+    if isinstance(default, float):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+            raise wrong("a number")
+        v = float(value)
+        return repr(v) if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise wrong("a str")
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    raise wrong(type(default).__name__)
+
+
+def _options(env_id, options: dict) -> dict:
+    """Keyword options as {key: TOML text} for the C++ side, which checks names and ranges."""
+    _check_id(env_id)
+    valid = _pamdp.option_names(env_id)  # ValueError for an unknown id, naming the valid ones
+    defaults = tomllib.loads(_pamdp.defaults_toml(env_id))["env"]
+    out = {}
+    for key, value in options.items():
+        # An unknown or fixed key: the C++ side raises the ValueError naming the valid ones.
+        out[key] = _toml_value(env_id, key, value, defaults[key]) if key in valid else "0"
+    return out
+
+
+class Env(_pamdp.Env):
+    """One env with Gymnasium's API: reset(seed=None, options=None) -> (obs, info) and
+    step(action) -> (obs, reward, terminated, truncated, info). Observations are fresh float32
+    arrays. A fresh env never seeded plays the episodes of seed 0; reset() without a seed
+    continues the env's own random stream, as `pamdp eval` does between episodes."""
+
+    metadata = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, env_id: str = "hfo-1v0", **options):
+        super().__init__(env_id, _options(env_id, options))
+        bound = self.observation_bound
+        self.observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
+        self.action_space = spaces.action_space(self.actions)
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def options(self) -> dict:
+        """The env's settings that make() takes, defaults included: make(env.env_id, **env.options)
+        builds the same env."""
+        table = tomllib.loads(self.config_toml)["env"]
+        return {k: table[k] for k in _pamdp.option_names(self.env_id)}
+
+    def render(self):
+        return None
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self):
+        return f"pamdp.Env('{self.env_id}')"
+
+
+class VectorEnv(_pamdp.VectorEnv):
+    """num_envs envs stepped together in C++ (num_threads threads), writing into preallocated
+    NumPy arrays: step(actions) -> (obs (N, obs), reward (N,), terminated (N,), truncated (N,),
+    info) with info["status"] the envs' status codes. actions is (ids of shape (N,), params),
+    params a tuple of one (N, k) float32 array per discrete action or one (N, num_params) array;
+    action_space.sample() draws such a batch.
+
+    Finished envs reset themselves (autoreset_mode): "next_step" (Gymnasium >= 1.0's default,
+    EnvPool's) resets an env on the step after its episode ended, ignoring that step's action
+    and returning the new episode's first obs with reward 0; "same_step" resets at once and puts
+    the terminal obs in info["final_obs"] (rows where info["_final_obs"] is True).
+    With copy=True (default) every call returns fresh arrays; copy=False returns the
+    preallocated buffers themselves, which the next call overwrites (no copy at all).
+    reset(seed=s) seeds env i with s + i (a sequence gives each env its own); the first reset
+    without a seed uses 0 + i."""
+
+    metadata = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,
+                 autoreset_mode: str = "next_step", copy: bool = True, **options):
+        for name, value in (("num_envs", num_envs), ("num_threads", num_threads)):
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                raise TypeError(f"{name} must be an int, got {type(value).__name__}")
+        if not isinstance(autoreset_mode, str):
+            raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
+        super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
+                         bool(copy))
+        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
+        bound = self.observation_bound
+        self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
+        self.single_action_space = spaces.action_space(self.actions)
+        self.observation_space = spaces.Box(-bound, bound, (self.num_envs, self.observation_size), np.float32)
+        self.action_space = spaces.action_space(self.actions, self.num_envs)
+
+    @property
+    def unwrapped(self):
+        return self
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self):
+        return f"pamdp.VectorEnv('{self.env_id}', num_envs={self.num_envs}, num_threads={self.num_threads})"
+
+
+class Policy(_pamdp.Policy):
+    """A checkpoint's actor: policy(obs) for one observation (obs_size,) returns one action
+    (id, params); for a batch (B, obs_size) it returns (ids (B,), params), the vector env's
+    action format. Greedy by default: the action `pamdp eval` plays (the actor copy its run
+    evaluated, masked actions never chosen, parameters as the actor outputs them; the env clamps
+    them). With exploration=True: the checkpoint's ε-greedy selection at `epsilon` (default: its
+    schedule's value at the checkpoint's update count), seeded by `seed`."""
+
+    def make_env(self) -> Env:
+        """The env the checkpoint was trained on, with its settings."""
+        table = tomllib.loads(self.config_toml)["env"]
+        return make(self.env_id, **{k: table[k] for k in _pamdp.option_names(self.env_id)})
+
+    def __repr__(self):
+        return f"pamdp.Policy(env '{self.env_id}', {self.updates} updates, actor {self.actor})"
+
+
+def make(env_id: str = "hfo-1v0", **options) -> Env:
+    """A new env: make("hfo-1v0"), make("hfo-1v1"), make("reach_stop"), make("hfo", goalie=True),
+    with env options as keyword arguments (noise=False, start="hfo", max_steps=300, ...)."""
+    return Env(env_id, **options)
+
+
+def make_vec(env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,
+             autoreset_mode: str = "next_step", copy: bool = True, **options) -> VectorEnv:
+    """num_envs envs of make(env_id, **options) stepped in C++ (see VectorEnv)."""
+    return VectorEnv(env_id, num_envs, num_threads, autoreset_mode, copy, **options)
+
+
+def load_policy(path, exploration: bool = False, epsilon=None, seed: int = 0, actor: str = "evaluated") -> Policy:
+    """The actor of a checkpoint (models/*.ckpt, a run's checkpoint.ckpt or best.ckpt) as a
+    callable policy; actor is "evaluated" (the copy its run's evaluations played, as `pamdp eval`
+    picks), "online", "target" or "average"."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a str or os.PathLike, got {type(path).__name__}")
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"no checkpoint at '{path}' (trained agents: models/*.ckpt)")
+    if epsilon is not None and (isinstance(epsilon, bool) or not isinstance(epsilon, numbers.Real)):
+        raise TypeError(f"epsilon must be a number or None, got {type(epsilon).__name__}")
+    if not isinstance(actor, str):
+        raise TypeError(f"actor must be a str, got {type(actor).__name__}")
+    return Policy(path, bool(exploration), None if epsilon is None else float(epsilon), seed, actor)
+
+
+def evaluate(policy, env=None, episodes: int = 100, seed: int = 1) -> dict:
+    """Plays `episodes` episodes as `pamdp eval` does (the first reset with `seed`, later ones
+    continuing the env's stream) and returns its JSON keys: episodes, goal_rate,
+    avg_steps_to_goal, avg_return, avg_steps, outcomes. `env` defaults to policy.make_env()."""
+    env = policy.make_env() if env is None else env
+    success = env.success_status
+    outcomes = {name: 0 for status, name in env.outcomes if status != 0}
+    total_return, total_steps, goal_steps, goals = 0.0, 0, 0, 0
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed) if ep == 0 else env.reset()
+        steps, done = 0, False
+        while not done:
+            obs, reward, terminated, truncated, info = env.step(policy(obs))
+            total_return += reward
+            steps += 1
+            done = terminated or truncated
+        total_steps += steps
+        outcomes[info["outcome"]] += 1
+        if info["status"] == success:
+            goals += 1
+            goal_steps += steps
+    return {
+        "episodes": episodes,
+        "goal_rate": goals / episodes if episodes else 0.0,
+        "avg_steps_to_goal": goal_steps / goals if goals else 0.0,
+        "avg_return": total_return / episodes if episodes else 0.0,
+        "avg_steps": total_steps / episodes if episodes else 0.0,
+        "outcomes": outcomes,
+    }
+
+
+try:  # Gymnasium is optional: when it is importable, gymnasium.make("pamdp/hfo-1v0") works too.
+    import gymnasium as _gymnasium  # noqa: F401
+except ImportError:
+    pass
+else:
+    from . import gymnasium_env as _gymnasium_env
+
+    _gymnasium_env.register()
