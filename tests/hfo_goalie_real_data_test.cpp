@@ -179,5 +179,54 @@ TEST(HfoGoalieRealData, CommandAndNextStateAgreeWithTheRealGoalie) {
   EXPECT_GE(physics_ok, 0.97 * n);
 }
 
+// Whole episodes (tests/data/hfo-real-goalie-episodes.csv: episodes 1-50 of scripted_s401,
+// every cycle): each starts from its recorded t = 0 state, the attacker's recorded commands
+// are replayed as the server received them, and the embedded goalie plays. With noise off the
+// real game is deterministic, so the goalie's path and the outcome must follow the recording
+// for as long as its decisions do. Targets: the goalie within 0.01 m of its recorded position
+// in >= 97 % of all cycles, and the same outcome in >= 47 of the 50 episodes.
+TEST(HfoGoalieRealData, WholeEpisodesFollowTheRecording) {
+  const std::vector<CsvRow> rows =
+      testing::load_csv_rows(std::string(PAMDP_REAL_DATA_DIR) + "/hfo-real-goalie-episodes.csv");
+  ASSERT_EQ(rows.size(), 3740U) << "tests/data/hfo-real-goalie-episodes.csv is missing or truncated";
+  static const std::map<std::string, int> kStatus{{"IN_GAME", kInGame},
+                                                  {"GOAL", kGoal},
+                                                  {"CAPTURED_BY_DEFENSE", kCapturedByDefense},
+                                                  {"OUT_OF_BOUNDS", kOutOfBounds},
+                                                  {"OUT_OF_TIME", kOutOfTime}};
+  int cycles = 0;
+  int close = 0;
+  int episodes = 0;
+  int same_outcome = 0;
+  size_t i = 0;
+  while (i < rows.size()) {
+    const std::string ep = rows[i].str("ep");
+    SoccerSim sim = sim_at(rows[i], true);
+    int status = kInGame;
+    int recorded = kInGame;
+    for (; i < rows.size() && rows[i].str("ep") == ep; ++i) {
+      const CsvRow& r = rows[i];
+      recorded = kStatus.at(r.str("n_status"));
+      if (status != kInGame) {
+        continue;  // our episode already ended: the rest of the recording is not comparable
+      }
+      sim.command_as_received(0, r.str("a_cmd").c_str(), r.num("a_p1"), r.num("a_p2"));
+      status = sim.step();
+      const NextErrors e = goalie_error(sim, r);
+      ++cycles;
+      // Open loop: the attacker's recorded commands act on our state, which the goalie changes
+      // only through collisions and catches.
+      close += e.pos <= 0.01 ? 1 : 0;
+    }
+    ++episodes;
+    same_outcome += status == recorded ? 1 : 0;
+  }
+  std::printf("whole episodes: goalie within 0.01 m in %.1f %% of %d cycles; same outcome in %d of %d episodes\n",
+              100.0 * close / cycles, cycles, same_outcome, episodes);
+  EXPECT_EQ(episodes, 50);
+  EXPECT_GE(close, 0.97 * cycles);
+  EXPECT_GE(same_outcome, 47);
+}
+
 }  // namespace
 }  // namespace pamdp::hfo

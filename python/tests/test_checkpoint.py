@@ -17,13 +17,15 @@ import pamdp
 
 PAMDP = SOURCE = None
 CASES = [  # (checkpoint, episodes, seed): few episodes, so that the test takes seconds
-    ("models/hfo-1v0-fast-eps005-seed2.ckpt", 100, 1),  # README's bold row: 1.000 / 72.1
-    ("models/hfo-1v1-side-seed2.ckpt", 60, 3),  # against the goalie; plays its actor average
+    # (path, episodes, seed, a goal rate it beats: the policy plays, it is not a random one)
+    ("models/hfo-1v0-fast-eps005-seed2.ckpt", 100, 1, 0.5),  # README's bold row: 1.000 / 72.1
+    # Against agent2d's goalie, which it was not trained against; plays its actor average.
+    ("models/hfo-1v1-side-seed2.ckpt", 60, 3, 0.05),
 ]
 
 
 class CheckpointFromPython(unittest.TestCase):
-    def check_against_pamdp_eval(self, path, episodes, seed):
+    def check_against_pamdp_eval(self, path, episodes, seed, floor):
         out = subprocess.run([PAMDP, "eval", "--checkpoint", path, "--episodes", str(episodes), "--seed", str(seed),
                               "--json"], check=True, capture_output=True, text=True)
         cpp = json.loads(out.stdout.strip().splitlines()[-1])
@@ -34,12 +36,12 @@ class CheckpointFromPython(unittest.TestCase):
         self.assertEqual(py["avg_steps"], cpp["avg_steps"])
         self.assertEqual(py["avg_return"], cpp["avg_return"])
         self.assertEqual(py["outcomes"], cpp["outcomes"])
-        self.assertGreater(py["goal_rate"], 0.5)
+        self.assertGreater(py["goal_rate"], floor)
 
     def test_eval_row_equals_pamdp_eval(self):
-        for path, episodes, seed in CASES:
+        for path, episodes, seed, floor in CASES:
             with self.subTest(checkpoint=path):
-                self.check_against_pamdp_eval(os.path.join(SOURCE, path), episodes, seed)
+                self.check_against_pamdp_eval(os.path.join(SOURCE, path), episodes, seed, floor)
 
     def test_toy_task_checkpoint(self):
         # A fresh reach_stop run (under a second) and its checkpoint, read back from Python.
@@ -47,7 +49,7 @@ class CheckpointFromPython(unittest.TestCase):
             subprocess.run([PAMDP, "train", "--config", os.path.join(SOURCE, "deploy/configs/reach_stop.toml"),
                             "--run-dir", run, "--seed", "3"], check=True, capture_output=True)
             path = os.path.join(run, "checkpoint.ckpt")
-            self.check_against_pamdp_eval(path, 200, 5)
+            self.check_against_pamdp_eval(path, 200, 5, 0.5)
             policy = pamdp.load_policy(path)
             self.assertEqual(policy.env_id, "reach_stop")
             ids, params = policy(np.zeros((3, 3), np.float32))
