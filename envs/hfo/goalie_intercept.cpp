@@ -310,7 +310,7 @@ class SelfIntercept {
     const bool goalie = goalie_mode(ball_next, kOurPenaltyLineX, kPenaltyHalfWidth);
     const double control_area = control_area_for(goalie);
     const Vec2 next_ball_rel = rotated(ball_next - my_next, -s_.body_deg);
-    const double ball_noise = w_.ball_vel.r() * kBallRand;
+    const double ball_noise = w_.ball_vel.r() * w_.ball_rand;
     const double next_ball_dist = next_ball_rel.r();
     if (next_ball_dist > control_area - 0.15 - ball_noise) {
       return false;
@@ -367,7 +367,7 @@ class SelfIntercept {
       return;
     }
     const double safety_ball_dist =
-        std::max(control_area - 0.2 - w_.ball_vel.r() * kBallRand, kPlayerSize + kBallSize + kKickableMargin * 0.4);
+        std::max(control_area - 0.2 - w_.ball_vel.r() * w_.ball_rand, kPlayerSize + kBallSize + kKickableMargin * 0.4);
     const InterceptInfo* best = &tmp.v[0];
     for (int k = 1; k < tmp.n; ++k) {
       const InterceptInfo& it = tmp.v[static_cast<size_t>(k)];
@@ -481,7 +481,7 @@ class SelfIntercept {
       if (tmp.n == 0) {
         continue;
       }
-      const double safety_ball_dist = std::max(control_area - 0.2 - dist(w_.ball_pos, ball_pos) * kBallRand,
+      const double safety_ball_dist = std::max(control_area - 0.2 - dist(w_.ball_pos, ball_pos) * w_.ball_rand,
                                                kPlayerSize + kBallSize + kKickableMargin * 0.4);
       const InterceptInfo* best = &tmp.v[0];
       for (int k = 1; k < tmp.n; ++k) {
@@ -796,7 +796,7 @@ class SelfIntercept {
       *dash_angle = angle_norm(*dash_angle + 180.0);
       angle_diff = 180.0 - angle_diff;
     }
-    const double max_moment = kMaxMoment * (1.0 - kPlayerRand);
+    const double max_moment = kMaxMoment * (1.0 - w_.player_rand);
     double speed = s_.vel.r();
     int n_turn = 0;
     while (angle_diff > turn_margin) {
@@ -834,12 +834,12 @@ class SelfIntercept {
   // canReachAfterDash: full-power dashes (less when stamina runs short) along `dash_angle`.
   bool can_reach_after_dash(int n_turn, int n_dash, Vec2 ball_pos, double control_area, bool save_recovery,
                             double dash_angle, bool back_dash) {
-    const double player_noise_rate = 1.0 - kPlayerRand * 0.01;
+    const double player_noise_rate = 1.0 - w_.player_rand * 0.01;
     const double max_power = kMaxDashPower;
     const Vec2 my_inertia = self_inertia(n_turn + n_dash);
     const double recover_dec_thr = kRecoverDecThrValue;
     const Vec2 ball_rel = rotated(ball_pos - s_.pos, -dash_angle);
-    const double ball_noise = dist(w_.ball_pos, ball_pos) * kBallRand * 0.5;
+    const double ball_noise = dist(w_.ball_pos, ball_pos) * w_.ball_rand * 0.5;
     const double noised_ball_x = ball_rel.x + ball_noise;
     Vec2 tmp_pos = rotated(player_inertia_travel(s_.vel, n_turn), -dash_angle);
     Vec2 tmp_vel = rotated(s_.vel * std::pow(kPlayerDecay, n_turn), -dash_angle);
@@ -892,7 +892,7 @@ class SelfIntercept {
       }
     }
     const double player_travel = tmp_pos.r();
-    const double player_noise = player_travel * kPlayerRand * 0.5;
+    const double player_noise = player_travel * w_.player_rand * 0.5;
     const double last_ball_dist = dist(ball_rel, tmp_pos);
     const double buf = 0.2 + player_noise + ball_noise;
     if (last_ball_dist < std::max(control_area - 0.225, control_area - buf)) {
@@ -1297,7 +1297,7 @@ bool wait_turn(const GoalieWorld& w, const InterceptTable& t, Vec2 target_point,
   const double target_dist = target_rel.r();
   // inertia_n_step_distance of the ball.
   const double ball_travel = w.ball_vel.r() * (1.0 - std::pow(kBallDecay, info.reach_cycle())) / (1.0 - kBallDecay);
-  const double ball_noise = ball_travel * kBallRand;
+  const double ball_noise = ball_travel * w.ball_rand;
   if (info.reach_cycle() == 1 && info.turn_cycle == 1) {
     body_turn_to_point(w, default_face_point(w, 0.9), 1, out);
     return true;

@@ -67,6 +67,10 @@ struct GoalieWorld {
   int num_opponents = 0;
   // Cycles since the goalie's last catch command; a large value when it has not caught.
   int since_catch = 1000;
+  // The server's ball_rand and player_rand as the client reads them (ServerParam): librcsc's
+  // intercept margins shrink with them. The recorded real games ran with both 0 (noise off).
+  double ball_rand = kBallRand;
+  double player_rand = kPlayerRand;
 
   // Derived values, as librcsc computes them (set by finish(), which the builder calls).
   double ball_dist_from_self = 0.0;
