@@ -21,7 +21,6 @@
 #include "envs/hfo/soccer_sim.hpp"
 
 namespace pamdp::hfo {
-extern thread_local char g_goalie_rule[512];  // DEBUG
 namespace {
 
 using testing::CsvRow;
@@ -131,7 +130,6 @@ TEST(HfoGoalieRealData, CommandAndNextStateAgreeWithTheRealGoalie) {
     SoccerSim sim = sim_at(r, true);
     const GoalieCommand c = decide_goalie(sim.state(), kGoalieIndex);
     const std::string mine = goalie_command_name(c.kind);
-    const std::string rule = g_goalie_rule;
     const bool same_kind = mine == logged;
     const bool same = same_kind && params_agree(c, r);
     kind_ok += same_kind ? 1 : 0;
@@ -154,10 +152,10 @@ TEST(HfoGoalieRealData, CommandAndNextStateAgreeWithTheRealGoalie) {
     const NextErrors pe = goalie_error(phys, r);
     physics_ok += (pe.pos <= 0.01 && pe.body <= 0.5) ? 1 : 0;
     if (mismatches != nullptr && (!same || !next_good)) {
-      std::fprintf(mismatches, "%s,%s,%s,logged=%s %s %s,mine=%s %.3f %.3f,next_err=%.4f/%.2f,phys_err=%.4f/%.2f,%s\n",
+      std::fprintf(mismatches, "%s,%s,%s,logged=%s %s %s,mine=%s %.3f %.3f,next_err=%.4f/%.2f,phys_err=%.4f/%.2f\n",
                    r.str("id").c_str(), r.str("tags").c_str(), r.str("src").c_str(), logged.c_str(),
                    r.str("g_p1").c_str(), r.str("g_p2").c_str(), mine.c_str(), c.p1, c.p2, e.pos, e.body, pe.pos,
-                   pe.body, rule.c_str());
+                   pe.body);
     }
   }
   if (mismatches != nullptr) {

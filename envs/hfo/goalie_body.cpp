@@ -211,7 +211,7 @@ bool adjust_dash(const GoalieWorld& w, Vec2 target, double dist_thr, double max_
     StaminaSim stamina{w.self.stamina, w.self.effort, w.self.recovery, w.self.capacity};
     double first_power = kIllegalPower;
     // PlayerType::inertiaPoint from the origin with the relative velocity.
-    Vec2 my_pos = rel_vel * ((1.0 - std::pow(kPlayerDecay, cycle_n)) / (1.0 - kPlayerDecay));
+    Vec2 my_pos = rel_vel * ((1.0 - player_decay_pow(cycle_n)) / (1.0 - kPlayerDecay));
     int c = 0;
     for (; c < max_cycle; ++c) {
       const Vec2 required_move = rotate(target_rel - my_pos, -dash_angle);

@@ -47,7 +47,7 @@ int cycles_to_reach_distance(double dash_dist) {
 }
 
 Vec2 inertia_point(Vec2 pos, Vec2 vel, int n) {
-  return pos + vel * ((1.0 - std::pow(kPlayerDecay, n)) / (1.0 - kPlayerDecay));
+  return pos + vel * ((1.0 - player_decay_pow(n)) / (1.0 - kPlayerDecay));
 }
 
 double th_deg(Vec2 v) {
@@ -177,14 +177,15 @@ int provisional_self_reach(const GoalieWorld& w, const InterceptTable& t) {
 
 }  // namespace
 
-void predict_intercepts(const GoalieWorld& w, InterceptTable* t) {
-  *t = InterceptTable{};
+void predict_ball_and_opponents(const GoalieWorld& w, InterceptTable* t) {
+  t->ball_cache_size = 0;
+  t->self_cache_size = 0;
+  t->self_reach_cycle = 1000;
+  t->self_exhaust_reach_cycle = 1000;
+  t->opponent_reach_cycle = 1000;
+  t->teammate_reach_cycle = 1000;
+  t->self_predicted = false;
   create_ball_cache(w, t);
-  if (w.self_kickable) {
-    t->self_reach_cycle = 0;
-  } else {
-    t->self_reach_cycle = provisional_self_reach(w, *t);
-  }
   // InterceptTable::predictOpponent: 0 with a kickable opponent, else the fastest one.
   if (w.exist_kickable_opponent) {
     t->opponent_reach_cycle = 0;
@@ -193,6 +194,11 @@ void predict_intercepts(const GoalieWorld& w, InterceptTable* t) {
       t->opponent_reach_cycle = std::min(t->opponent_reach_cycle, predict_opponent(w, *t, w.opponents[i]));
     }
   }
+}
+
+void predict_self(const GoalieWorld& w, InterceptTable* t) {
+  t->self_predicted = true;
+  t->self_reach_cycle = w.self_kickable ? 0 : provisional_self_reach(w, *t);
 }
 
 bool body_intercept(const GoalieWorld& w, const InterceptTable& t, bool, Command* out) {

@@ -104,11 +104,18 @@ struct InterceptTable {
   int self_exhaust_reach_cycle = 1000;
   int opponent_reach_cycle = 1000;
   int teammate_reach_cycle = 1000;  // HFO's defense has no field players here: always 1000
+  bool self_predicted = false;      // predict_self() has filled the self_* members
 };
 
-// Fills `table` from `world` (InterceptTable::update with SelfInterceptV13 and
-// PlayerIntercept). Implemented in goalie_intercept.cpp.
-void predict_intercepts(const GoalieWorld& world, InterceptTable* table);
+// InterceptTable::update in two parts (goalie_intercept.cpp): the ball's path and the
+// opponents' reach (PlayerIntercept), which every cycle needs, and the goalie's own ways to the
+// ball (SelfInterceptV13), which only some rules read, so the goalie computes them on demand.
+void predict_ball_and_opponents(const GoalieWorld& world, InterceptTable* table);
+void predict_self(const GoalieWorld& world, InterceptTable* table);
+inline void predict_intercepts(const GoalieWorld& world, InterceptTable* table) {
+  predict_ball_and_opponents(world, table);
+  predict_self(world, table);
+}
 
 // --- Commands, in the server's units (what the .rcl logs) -------------------------------
 
@@ -144,13 +151,33 @@ bool go_to_point_look_ball(const GoalieWorld& w, Vec2 target, double dist_thr, d
 // Body_Intercept2009 (implemented in goalie_intercept.cpp).
 bool body_intercept(const GoalieWorld& w, const InterceptTable& table, bool save_recovery, Command* out);
 
+// decay^n for the inertia sums, the same values std::pow gives, looked up for small n.
+struct DecayPowers {
+  static constexpr int kSize = 128;
+  std::array<double, kSize> ball{};
+  std::array<double, kSize> player{};
+  DecayPowers() {
+    for (int n = 0; n < kSize; ++n) {
+      ball[static_cast<size_t>(n)] = std::pow(kBallDecay, n);
+      player[static_cast<size_t>(n)] = std::pow(kPlayerDecay, n);
+    }
+  }
+};
+inline const DecayPowers kDecayPowers;
+inline double ball_decay_pow(int n) {
+  return n >= 0 && n < DecayPowers::kSize ? kDecayPowers.ball[static_cast<size_t>(n)] : std::pow(kBallDecay, n);
+}
+inline double player_decay_pow(int n) {
+  return n >= 0 && n < DecayPowers::kSize ? kDecayPowers.player[static_cast<size_t>(n)] : std::pow(kPlayerDecay, n);
+}
+
 // Ball and player inertia helpers (librcsc inertia_n_step_point and friends).
 inline Vec2 ball_inertia_point(const GoalieWorld& w, int n) {
-  const double k = (1.0 - std::pow(kBallDecay, n)) / (1.0 - kBallDecay);
+  const double k = (1.0 - ball_decay_pow(n)) / (1.0 - kBallDecay);
   return w.ball_pos + w.ball_vel * k;
 }
 inline Vec2 self_inertia_point(const GoalieWorld& w, int n) {
-  const double k = (1.0 - std::pow(kPlayerDecay, n)) / (1.0 - kPlayerDecay);
+  const double k = (1.0 - player_decay_pow(n)) / (1.0 - kPlayerDecay);
   return w.self.pos + w.self.vel * k;
 }
 inline Vec2 self_inertia_final_point(const GoalieWorld& w) {
