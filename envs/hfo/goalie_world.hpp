@@ -11,7 +11,9 @@
 // Nothing here allocates; every call is O(intercept horizon) at most.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "envs/hfo/geometry.hpp"
@@ -95,7 +97,7 @@ struct InterceptInfo {
 // opponents' and teammates' reach cycles (1000 = cannot within the horizon).
 struct InterceptTable {
   static constexpr int kMaxCycle = 30;  // InterceptTable::MAX_CYCLE
-  static constexpr int kMaxSelfCache = 2 * (kMaxCycle + 2);
+  static constexpr int kMaxSelfCache = 3 * (kMaxCycle + 2);
   std::array<Vec2, kMaxCycle + 2> ball_cache{};
   int ball_cache_size = 0;
   std::array<InterceptInfo, kMaxSelfCache> self_cache{};
@@ -107,11 +109,57 @@ struct InterceptTable {
   bool self_predicted = false;      // predict_self() has filled the self_* members
 };
 
+// librcsc StaminaModel (common/stamina_model.cpp): simulateWait and simulateDash of player type 0.
+struct StaminaModel {
+  double stamina = kStaminaMax;
+  double effort = 1.0;
+  double recovery = 1.0;
+  double capacity = kStaminaCapacity;
+
+  void wait() {
+    if (stamina <= kRecoverDecThreshold && recovery > kRecoverMin) {
+      recovery = std::max(kRecoverMin, recovery - kRecoverDec);
+    }
+    if (stamina <= kEffortDecThreshold) {
+      if (effort > kEffortMin) {
+        effort = std::max(kEffortMin, effort - kEffortDec);
+      }
+    } else if (stamina >= kEffortIncThreshold && effort < kEffortMax) {
+      effort = std::min(kEffortMax, effort + kEffortInc);
+    }
+    const double inc = std::min(kStaminaIncMax * recovery, kStaminaMax - stamina);
+    stamina += std::min(inc, capacity);
+    capacity = std::max(0.0, capacity - inc);
+    stamina = std::min(stamina, kStaminaMax);
+  }
+  void waits(int n) {
+    for (int i = 0; i < n; ++i) {
+      wait();
+    }
+  }
+  void dash(double power) {
+    stamina = std::max(0.0, stamina - (power >= 0.0 ? power : -2.0 * power));
+    wait();
+  }
+  void dashes(int n, double power) {
+    for (int i = 0; i < n; ++i) {
+      dash(power);
+    }
+  }
+  [[nodiscard]] bool capacity_is_empty() const { return capacity <= 1.0e-5 && capacity >= 0.0; }
+};
+
+inline StaminaModel stamina_of(const SelfView& s) {
+  return {s.stamina, s.effort, s.recovery, s.capacity};
+}
+
 // InterceptTable::update in two parts (goalie_intercept.cpp): the ball's path and the
 // opponents' reach (PlayerIntercept), which every cycle needs, and the goalie's own ways to the
 // ball (SelfInterceptV13), which only some rules read, so the goalie computes them on demand.
 void predict_ball_and_opponents(const GoalieWorld& world, InterceptTable* table);
 void predict_self(const GoalieWorld& world, InterceptTable* table);
+// PlayerType::cyclesToReachDistance for player type 0 (full dashes from rest).
+int cycles_to_reach_distance(double dash_dist);
 inline void predict_intercepts(const GoalieWorld& world, InterceptTable* table) {
   predict_ball_and_opponents(world, table);
   predict_self(world, table);
