@@ -515,7 +515,7 @@ bool in_catch_area(Vec2 p) {
 
 }  // namespace
 
-agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
+agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_noise) {
   // rcssserver sends the right side every position mirrored through the centre.
   auto mirror = [](Vec2 v) { return Vec2{-v.x, -v.y}; };
   const PlayerState& me = s.players[goalie];
@@ -531,6 +531,8 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
   w.ball_pos = mirror(s.ball.pos);
   w.ball_vel = mirror(s.ball.vel);
   w.since_catch = me.since_catch;
+  w.player_rand = server_noise ? kPlayerRand : 0.0;
+  w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {
     const PlayerState& p = s.players[i];
     if (p.team == me.team || w.num_opponents == GoalieWorld::kMaxOpponents) {
@@ -557,8 +559,8 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
   return w;
 }
 
-GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
-  const GoalieWorld w = goalie_world(s, goalie);
+GoalieCommand decide_goalie(const SoccerState& s, int goalie, bool server_noise) {
+  const GoalieWorld w = goalie_world(s, goalie, server_noise);
   if (w.self.frozen) {
     return {};  // librcsc refuses every body command while the tackle freezes the player
   }

@@ -378,7 +378,7 @@ bool wait_turn(const GoalieWorld& w, const InterceptTable& t, Vec2 target_point,
   const Vec2 target_rel = rotate_deg(target_point - my_inertia, -w.self.body_deg);
   const double target_dist = target_rel.r();
   const double ball_travel = w.ball_vel.r() * (1.0 - ball_decay_pow(info.reach_cycle())) / (1.0 - kBallDecay);
-  const double ball_noise = ball_travel * 0.05;
+  const double ball_noise = ball_travel * w.ball_rand;
   if (info.reach_cycle() == 1 && info.turn_cycle == 1) {
     body_turn_to_point(w, Vec2{50.5, w.self.pos.y * 0.9}, 1, out);
     return true;

@@ -20,8 +20,6 @@ constexpr double kControlAreaBuf = 0.15;     // control_area_buf (2009-07-03)
 constexpr double kRealSpeedMax = std::min(kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay), kPlayerSpeedMax);
 constexpr double kOurPenaltyLineX = -kPitchHalfLength + 16.5;
 constexpr double kRecoverDecThrValue = kRecoverDecThreshold;  // recover_dec_thr x stamina_max
-constexpr double kBallRand = 0.05;
-constexpr double kPlayerRandDefault = 0.1;
 
 double th_deg(Vec2 v) {
   return std::atan2(v.y, v.x) * kRadToDeg;
@@ -157,7 +155,7 @@ class SelfIntercept {
     const bool goalie_mode = ball_next.x < kOurPenaltyLineX && std::fabs(ball_next.y) < kPenaltyBoxHalfWidth;
     const double control = goalie_mode ? kCatchableArea : kKickableArea;
     const Vec2 next_ball_rel = rotate(ball_next - my_next, -w_.self.body_deg);
-    const double ball_noise = w_.ball_vel.r() * kBallRand;
+    const double ball_noise = w_.ball_vel.r() * w_.ball_rand;
     const double next_ball_dist = next_ball_rel.r();
     if (next_ball_dist > control - 0.15 - ball_noise) {
       return false;
@@ -216,7 +214,7 @@ class SelfIntercept {
       return;
     }
     const double safety_ball_dist =
-        std::max(control - 0.2 - w_.ball_vel.r() * kBallRand, kPlayerSize + kBallSize + kKickableMargin * 0.4);
+        std::max(control - 0.2 - w_.ball_vel.r() * w_.ball_rand, kPlayerSize + kBallSize + kKickableMargin * 0.4);
     const InterceptInfo* best = &tmp[0];
     for (int i = 1; i < n_tmp; ++i) {
       const InterceptInfo* it = &tmp[static_cast<size_t>(i)];
@@ -332,7 +330,7 @@ class SelfIntercept {
       if (n_tmp_ == 0) {
         continue;
       }
-      const double safety_ball_dist = std::max(control - 0.2 - (w_.ball_pos - ball_pos).r() * kBallRand,
+      const double safety_ball_dist = std::max(control - 0.2 - (w_.ball_pos - ball_pos).r() * w_.ball_rand,
                                                kPlayerSize + kBallSize + kKickableMargin * 0.4);
       const InterceptInfo* best = &tmp_[0];
       for (int i = 1; i < n_tmp_; ++i) {
@@ -657,7 +655,7 @@ class SelfIntercept {
       *dash_angle = angle_norm(*dash_angle + 180.0);
       angle_diff = 180.0 - angle_diff;
     }
-    const double max_moment = kMaxMoment * (1.0 - kPlayerRandDefault);
+    const double max_moment = kMaxMoment * (1.0 - w_.player_rand);
     double speed = w_.self.vel.r();
     int n_turn = 0;
     while (angle_diff > turn_margin) {
@@ -693,11 +691,11 @@ class SelfIntercept {
 
   bool can_reach_after_dash(int n_turn, int n_dash, Vec2 ball_pos, double control, bool save_recovery,
                             double dash_angle, bool back_dash) {
-    const double player_noise_rate = 1.0 - kPlayerRandDefault * 0.01;
+    const double player_noise_rate = 1.0 - w_.player_rand * 0.01;
     const Vec2 my_inertia = self_inertia_point(w_, n_turn + n_dash);
     const double recover_dec_thr = kRecoverDecThreshold;
     const Vec2 ball_rel = rotate(ball_pos - w_.self.pos, -dash_angle);
-    const double ball_noise = (w_.ball_pos - ball_pos).r() * kBallRand * 0.5;
+    const double ball_noise = (w_.ball_pos - ball_pos).r() * w_.ball_rand * 0.5;
     const double noised_ball_x = ball_rel.x + ball_noise;
     // PlayerType::inertiaTravel of the velocity over the turns, in the dash frame.
     Vec2 tmp_pos = rotate(w_.self.vel * ((1.0 - player_decay_pow(n_turn)) / (1.0 - kPlayerDecay)), -dash_angle);
@@ -749,7 +747,7 @@ class SelfIntercept {
       }
     }
     const double player_travel = tmp_pos.r();
-    const double player_noise = player_travel * kPlayerRandDefault * 0.5;
+    const double player_noise = player_travel * w_.player_rand * 0.5;
     const double last_ball_dist = (ball_rel - tmp_pos).r();
     const double buf = 0.2 + player_noise + ball_noise;
     if (last_ball_dist < std::max(control - 0.225, control - buf)) {

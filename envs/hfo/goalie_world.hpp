@@ -69,6 +69,10 @@ struct GoalieWorld {
   int num_opponents = 0;
   // Cycles since the goalie's last catch command; a large value when it has not caught.
   int since_catch = 1000;
+  // The server's noise parameters, which librcsc reads from the server and builds into its
+  // intercept margins (player_rand, ball_rand): 0.1 and 0.05 by default, 0 with noise off.
+  double player_rand = kPlayerRand;
+  double ball_rand = kBallRand;
 
   // Derived values, as librcsc computes them (set by finish(), which the builder calls).
   double ball_dist_from_self = 0.0;
