@@ -100,13 +100,20 @@ class SelfIntercept {
     predict_short_step(max_cycle, save_recovery);
     predict_long_step(max_cycle, save_recovery);
     predict_long_step(max_cycle, false);
-    // InterceptInfo::Cmp: reach cycle, then turn cycle (std::sort: the order of ties is
-    // unspecified there as here; the first of the best reach cycle is what the table reads).
-    std::stable_sort(t_->self_cache.begin(), t_->self_cache.begin() + t_->self_cache_size,
-                     [](const InterceptInfo& a, const InterceptInfo& b) {
-                       return a.reach_cycle() < b.reach_cycle() ||
-                              (a.reach_cycle() == b.reach_cycle() && a.turn_cycle < b.turn_cycle);
-                     });
+    // InterceptInfo::Cmp: reach cycle, then turn cycle. An insertion sort keeps equal entries
+    // in order and allocates nothing (std::stable_sort may).
+    auto before = [](const InterceptInfo& a, const InterceptInfo& b) {
+      return a.reach_cycle() < b.reach_cycle() || (a.reach_cycle() == b.reach_cycle() && a.turn_cycle < b.turn_cycle);
+    };
+    InterceptInfo* c = t_->self_cache.data();
+    for (int i = 1; i < t_->self_cache_size; ++i) {
+      const InterceptInfo x = c[i];
+      int j = i;
+      for (; j > 0 && before(x, c[j - 1]); --j) {
+        c[j] = c[j - 1];
+      }
+      c[j] = x;
+    }
   }
 
  private:
