@@ -299,12 +299,12 @@ TEST(HfoGoalie, DeterministicWithSeed) {
 }
 
 // The scripted offense against the goalie scores clearly less than on the empty goal, as
-// agent2d's offense does in the real HFO (.993 empty, .825 against agent2d's goalie), but is
-// not shut out. Measured over 1,000 episodes: about .998 empty and .84 against the goalie
-// (docs/results.md); with 300 episodes the standard error of the goalie rate is about .02, so
-// the bounds below (a drop of at least .10, a rate of at least .60) leave 3 and 10 standard
-// errors of room. The seed is fixed, so the test is deterministic anyway.
-TEST(HfoGoalie, ScriptedOffenseScoresClearlyLessAgainstGoalie) {
+// Against agent2d's goalie the scripted offense is mostly stopped, as it is on the real server
+// (.191 there, best course, 1,000 episodes; .209 here with the server's starts, docs/simulator.md),
+// while it scores on the empty goal. 300 episodes here measure .147 (standard error about .02),
+// so the bounds (.08 to .35, a drop of at least .5, captured in at least half the episodes)
+// leave 3 standard errors and more. The seed is fixed, so the test is deterministic anyway.
+TEST(HfoGoalie, ScriptedOffenseIsMostlyStoppedByTheGoalie) {
   constexpr int kEpisodes = 300;
   constexpr uint64_t kSeed = 20160101;
   SoccerSimConfig empty;
@@ -315,9 +315,10 @@ TEST(HfoGoalie, ScriptedOffenseScoresClearlyLessAgainstGoalie) {
   const EvalResult r_empty = evaluate(env_empty, policy, kEpisodes, kSeed);
   const EvalResult r_goalie = evaluate(env_goalie, policy, kEpisodes, kSeed);
   EXPECT_GE(r_empty.goal_rate, 0.95) << to_json(r_empty);
-  EXPECT_LE(r_goalie.goal_rate, r_empty.goal_rate - 0.10) << to_json(r_goalie);
-  EXPECT_GE(r_goalie.goal_rate, 0.60) << to_json(r_goalie);
-  EXPECT_GE(r_goalie.outcomes.at("CAPTURED_BY_DEFENSE"), kEpisodes / 20) << to_json(r_goalie);
+  EXPECT_LE(r_goalie.goal_rate, r_empty.goal_rate - 0.5) << to_json(r_goalie);
+  EXPECT_GE(r_goalie.goal_rate, 0.08) << to_json(r_goalie);
+  EXPECT_LE(r_goalie.goal_rate, 0.35) << to_json(r_goalie);
+  EXPECT_GE(r_goalie.outcomes.at("CAPTURED_BY_DEFENSE"), kEpisodes / 2) << to_json(r_goalie);
 }
 
 // Where the scripted offense's goals cross the goal line (y, m; the bottom post is at +7) over
@@ -346,37 +347,41 @@ std::vector<double> goal_crossings(ShotAim aim, int episodes) {
 // ShotAim::kBottomPost shoots inside the bottom post, so its goals go in on the bottom half of
 // the mouth; the best course goes in on both sides (the corner away from the keeper). A goal
 // from a ball dribbled in, or a shot bent by the kick noise, can land elsewhere, hence 90 %.
+// Against agent2d's goalie goals are rarer, so 400 episodes give the 25 goals each needs.
 TEST(HfoGoalie, BottomPostAimScoresOnTheBottomHalf) {
   const auto share_bottom = [](const std::vector<double>& ys, double y0) {
     return static_cast<double>(std::count_if(ys.begin(), ys.end(), [y0](double y) { return y > y0; })) /
            static_cast<double>(ys.size());
   };
-  const std::vector<double> post = goal_crossings(ShotAim::kBottomPost, 100);
-  const std::vector<double> best = goal_crossings(ShotAim::kBestCourse, 100);
-  ASSERT_GE(post.size(), 50U);
-  ASSERT_GE(best.size(), 50U);
+  const std::vector<double> post = goal_crossings(ShotAim::kBottomPost, 400);
+  const std::vector<double> best = goal_crossings(ShotAim::kBestCourse, 400);
+  ASSERT_GE(post.size(), 25U);
+  ASSERT_GE(best.size(), 25U);
   EXPECT_GE(share_bottom(post, 2.0), 0.9);
   EXPECT_LE(share_bottom(best, 2.0), 0.8);
   EXPECT_GE(share_bottom(best, 2.0), 0.2);
   // kBottomSide shoots as kBottomPost does, so its goals go in on the same side.
-  const std::vector<double> side = goal_crossings(ShotAim::kBottomSide, 100);
-  ASSERT_GE(side.size(), 50U);
+  const std::vector<double> side = goal_crossings(ShotAim::kBottomSide, 400);
+  ASSERT_GE(side.size(), 25U);
   EXPECT_GE(share_bottom(side, 2.0), 0.9);
 }
 
-// kBottomSide's patience from far out and its dribble toward the bottom post beat the goalie
-// more often than kBottomPost, which shoots the same way: .90 against .80 on 4,000 episodes (.906
-// against .813 on these 1,000 starts), so it is 6 points up at least (sampling noise about ±.012).
-TEST(HfoGoalie, BottomSideScoresMoreThanBottomPost) {
+// The shot aims rank against agent2d's goalie as on the real server, where the best course
+// scores .191 and bottom-side .130 (1,000 episodes each, docs/simulator.md): here, on the
+// server's starts, .209 and .145 on these 1,000 starts (sampling noise about ±.012), so the best
+// course leads by 3 points at least. (Bottom-side led against the hand-tuned keeper it replaced.)
+TEST(HfoGoalie, BestCourseScoresMoreThanBottomSideAsOnTheRealServer) {
   const auto rate = [](ShotAim aim) {
-    HfoEnv env(goalie_config(true));
+    SoccerSimConfig c = goalie_config(true);
+    c.start = StartDistribution::kHfo;
+    HfoEnv env(c);
     ScriptedOffense policy(aim);
-    return evaluate(env, policy, 1000, 11);
+    return evaluate(env, policy, 1000, 1);
   };
-  const EvalResult post = rate(ShotAim::kBottomPost);
+  const EvalResult best = rate(ShotAim::kBestCourse);
   const EvalResult side = rate(ShotAim::kBottomSide);
-  EXPECT_GE(side.goal_rate, post.goal_rate + 0.06) << to_json(side) << " against " << to_json(post);
-  EXPECT_GE(side.goal_rate, 0.87) << to_json(side);
+  EXPECT_GE(best.goal_rate, side.goal_rate + 0.03) << to_json(best) << " against " << to_json(side);
+  EXPECT_LE(best.goal_rate, 0.30) << to_json(best);
 }
 
 }  // namespace

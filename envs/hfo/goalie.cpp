@@ -5,13 +5,9 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 
 namespace pamdp::hfo {
-thread_local char g_goalie_rule[512];  // DEBUG
 namespace {
-#define RULE(name) (std::strncat(g_goalie_rule, name " ", sizeof(g_goalie_rule) - std::strlen(g_goalie_rule) - 1))
 
 using agent2d::angle_norm;
 using agent2d::Command;
@@ -60,8 +56,19 @@ bool valid(Vec2 p) {
 
 struct Context {
   const GoalieWorld& w;
-  const InterceptTable& t;
+  InterceptTable& t;
   Command* out;
+  // The goalie's own reach, predicted on first use (predict_self).
+  [[nodiscard]] int self_min() const {
+    if (!t.self_predicted) {
+      agent2d::predict_self(w, &t);
+    }
+    return t.self_reach_cycle;
+  }
+  [[nodiscard]] const InterceptTable& table_with_self() const {
+    (void)self_min();
+    return t;
+  }
 };
 
 // --- Bhv_GoalieBasicMove -------------------------------------------------------------------
@@ -97,7 +104,7 @@ Vec2 basic_target_point(const Context& c) {
   if (!w.exist_kickable_opponent) {
     ball_pred_cycle = std::min(ball_pred_cycle, c.t.opponent_reach_cycle);
     // inertia_n_step_point(base_pos, ball vel, n, ball_decay)
-    ball_point = base_pos + w.ball_vel * ((1.0 - std::pow(kBallDecay, ball_pred_cycle)) / (1.0 - kBallDecay));
+    ball_point = base_pos + w.ball_vel * ((1.0 - agent2d::ball_decay_pow(ball_pred_cycle)) / (1.0 - kBallDecay));
   }
   if (ball_point.x < base_point.x + 0.1) {
     ball_point.x = base_point.x + 0.1;
@@ -148,7 +155,6 @@ void go_to_point_look_ball(const Context& c, Vec2 target, double dist_thr, doubl
 }
 
 bool prepare_deep_cross(const Context& c, Vec2 move_point) {
-  RULE("prepare_deep_cross");
   const GoalieWorld& w = c.w;
   if (std::fabs(move_point.y) < kGoalHalfWidth - 0.8) {
     return false;
@@ -166,7 +172,6 @@ bool prepare_deep_cross(const Context& c, Vec2 move_point) {
 }
 
 bool stop_at_move_point(const Context& c, Vec2 move_point) {
-  RULE("stop_at_move_point");
   const GoalieWorld& w = c.w;
   const double thr = dist_thr_of(w, 0.1);
   if ((w.self.pos - move_point).r() < thr) {
@@ -181,7 +186,6 @@ bool stop_at_move_point(const Context& c, Vec2 move_point) {
 }
 
 bool go_to_move_point(const Context& c, Vec2 move_point) {
-  RULE("go_to_move_point");
   const GoalieWorld& w = c.w;
   const double thr = dist_thr_of(w, 0.08);
   const double y_diff = std::fabs(move_point.y - w.self.pos.y);
@@ -207,7 +211,6 @@ bool go_to_move_point(const Context& c, Vec2 move_point) {
 }
 
 bool move_for_dangerous_state(const Context& c, Vec2 move_point) {
-  RULE("move_for_dangerous_state");
   const GoalieWorld& w = c.w;
   const Vec2 ball_next = w.ball_pos + w.ball_vel;
   if (std::fabs(move_point.x - w.self.pos.x) > 0.5 && ball_next.x < -kPitchHalfLength + 11.0 &&
@@ -230,7 +233,6 @@ bool move_for_dangerous_state(const Context& c, Vec2 move_point) {
 }
 
 bool correct_x(const Context& c, Vec2 move_point) {
-  RULE("correct_x");
   const GoalieWorld& w = c.w;
   constexpr double kXBuf = 0.5;
   if (std::fabs(move_point.x - w.self.pos.x) < kXBuf) {
@@ -251,7 +253,6 @@ bool correct_x(const Context& c, Vec2 move_point) {
 }
 
 bool correct_body_dir(const Context& c, Vec2 move_point, bool consider_opp) {
-  RULE("correct_body_dir");
   const GoalieWorld& w = c.w;
   const Vec2 ball_next = w.ball_pos + w.ball_vel;
   const double target_angle = ball_next.y < 0.0 ? -90.0 : 90.0;
@@ -273,7 +274,6 @@ bool correct_body_dir(const Context& c, Vec2 move_point, bool consider_opp) {
 bool basic_tackle(const Context& c);
 
 void basic_move(const Context& c) {
-  RULE("basic_move");
   const Vec2 move_point = basic_target_point(c);
   if (basic_tackle(c) || prepare_deep_cross(c, move_point) || stop_at_move_point(c, move_point) ||
       move_for_dangerous_state(c, move_point) || correct_x(c, move_point) || correct_body_dir(c, move_point, true) ||
@@ -303,14 +303,13 @@ double tackle_probability(const GoalieWorld& w) {
 }
 
 bool basic_tackle(const Context& c) {
-  RULE("basic_tackle");
   const GoalieWorld& w = c.w;
   // In its own penalty area the goalie has no foul option (version 14 rule of
   // Bhv_BasicTackle::execute), and outside it HFO's goalie never stands.
   if (tackle_probability(w) < 0.8) {
     return false;
   }
-  const int self_min = c.t.self_reach_cycle;
+  const int self_min = c.self_min();
   const int opp_min = c.t.opponent_reach_cycle;
   const Vec2 self_reach_point = agent2d::ball_inertia_point(w, self_min);
   bool ball_into_goal = false;
@@ -367,7 +366,6 @@ bool basic_tackle(const Context& c) {
 // --- Bhv_GoalieChaseBall -------------------------------------------------------------------
 
 void go_to_catch_point(const Context& c, Vec2 target) {
-  RULE("go_to_catch_point");
   const GoalieWorld& w = c.w;
   const Vec2 d = target - w.self.pos;
   const double a = -w.self.body_deg * kDegToRad;
@@ -408,22 +406,41 @@ bool ball_shoot_moving(const GoalieWorld& w) {
   return false;
 }
 
+// Whether the ball's whole path, from where it is to where it stops, stays outside the region
+// x < x_max, |y| < y_max: then the point where the goalie would reach it does too, whatever the
+// cycle (x and y change monotonically along the path).
+bool path_stays_outside(const GoalieWorld& w, double x_max, double y_max) {
+  const Vec2 end = w.ball_pos + w.ball_vel * (1.0 / (1.0 - kBallDecay));
+  if (std::min(w.ball_pos.x, end.x) >= x_max) {
+    return true;
+  }
+  const double y_lo = std::min(w.ball_pos.y, end.y);
+  const double y_hi = std::max(w.ball_pos.y, end.y);
+  return y_lo >= y_max || y_hi <= -y_max;
+}
+
 bool ball_chase_situation(const Context& c) {
   const GoalieWorld& w = c.w;
-  const int self_min = c.t.self_reach_cycle;
   const int opp_min = c.t.opponent_reach_cycle;
   const Vec2 ball_next = w.ball_pos + w.ball_vel;
   if (ball_next.x < -kPitchHalfLength + 8.0 && std::fabs(ball_next.y) < kGoalHalfWidth + 3.0) {
+    const int self_min = c.self_min();
     if (w.ball_dist_from_self < 3.0 && self_min <= 3) {
       return true;
     }
     return !(self_min > opp_min + 3 && opp_min < 7);
   }
-  if (ball_shoot_moving(w) && self_min < opp_min) {
+  if (ball_shoot_moving(w) && c.self_min() < opp_min) {
     return true;
   }
-  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, self_min);
   const double pen_thr = std::max(1.0, w.ball_dist_from_self * 0.1 + 1.0);
+  // Below, a reach point outside its penalty area (less pen_thr) rules chasing out; the path
+  // tells that often without the goalie's own intercept prediction.
+  if (path_stays_outside(w, kOurPenaltyLineX - pen_thr, kPenaltyHalfWidth - pen_thr)) {
+    return false;
+  }
+  const int self_min = c.self_min();
+  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, self_min);
   if (std::fabs(my_int_pos.y) > kPenaltyHalfWidth - pen_thr || my_int_pos.x > kOurPenaltyLineX - pen_thr) {
     return false;
   }
@@ -439,22 +456,21 @@ bool ball_chase_situation(const Context& c) {
 }
 
 void chase_ball(const Context& c) {
-  RULE("chase_ball");
   const GoalieWorld& w = c.w;
   if (basic_tackle(c)) {
     return;
   }
-  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, c.t.self_reach_cycle);
+  const Vec2 my_int_pos = agent2d::ball_inertia_point(w, c.self_min());
   const double pen_thr = std::max(1.0, w.ball_dist_from_self * 0.1 + 1.0);
   const Line ball_line = Line::from(w.ball_pos, th_deg(w.ball_vel));
   const Line defend_line = Line::through({w.self.pos.x, -10.0}, {w.self.pos.x, 10.0});
   if (my_int_pos.x > -kPitchHalfLength - 1.0 && my_int_pos.x < kOurPenaltyLineX - pen_thr &&
       std::fabs(my_int_pos.y) < kPenaltyHalfWidth - pen_thr) {
     const bool save_recovery = ball_line.dist(w.self.pos) < agent2d::kCatchableArea;
-    agent2d::body_intercept(w, c.t, save_recovery, c.out);
+    agent2d::body_intercept(w, c.table_with_self(), save_recovery, c.out);
     return;
   }
-  const int self_min = c.t.self_reach_cycle;
+  const int self_min = c.self_min();
   const int opp_min = c.t.opponent_reach_cycle;
   Vec2 inter = ball_line.intersection(defend_line);
   if (!valid(inter) || ball_line.dist(w.self.pos) < agent2d::kCatchableArea * 0.8 ||
@@ -462,7 +478,7 @@ void chase_ball(const Context& c) {
     if (!w.exist_kickable_opponent) {
       if (self_min <= opp_min + 2 && my_int_pos.x > -kPitchHalfLength - 2.0 &&
           my_int_pos.x < kOurPenaltyLineX - pen_thr && std::fabs(my_int_pos.y) < kPenaltyHalfWidth - pen_thr) {
-        if (agent2d::body_intercept(w, c.t, false, c.out)) {
+        if (agent2d::body_intercept(w, c.table_with_self(), false, c.out)) {
           return;
         }
       }
@@ -473,7 +489,7 @@ void chase_ball(const Context& c) {
   if (std::fabs(inter.x) > kPitchHalfLength + agent2d::kCatchableArea ||
       inter.x > kOurPenaltyLineX - agent2d::kCatchableArea ||
       std::fabs(inter.y) > kPenaltyHalfWidth - agent2d::kCatchableArea) {
-    if (!agent2d::body_intercept(w, c.t, false, c.out)) {
+    if (!agent2d::body_intercept(w, c.table_with_self(), false, c.out)) {
       basic_move(c);
     }
     return;
@@ -499,7 +515,7 @@ bool in_catch_area(Vec2 p) {
 
 }  // namespace
 
-agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
+agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_noise) {
   // rcssserver sends the right side every position mirrored through the centre.
   auto mirror = [](Vec2 v) { return Vec2{-v.x, -v.y}; };
   const PlayerState& me = s.players[goalie];
@@ -515,6 +531,8 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
   w.ball_pos = mirror(s.ball.pos);
   w.ball_vel = mirror(s.ball.vel);
   w.since_catch = me.since_catch;
+  w.player_rand = server_noise ? kPlayerRand : 0.0;
+  w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {
     const PlayerState& p = s.players[i];
     if (p.team == me.team || w.num_opponents == GoalieWorld::kMaxOpponents) {
@@ -526,17 +544,23 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie) {
     o.body_deg = angle_norm(p.body_deg + 180.0);
     o.tackling = p.tackle_cycles > 0;
   }
-  std::sort(w.opponents.begin(), w.opponents.begin() + w.num_opponents,
-            [&](const agent2d::PlayerView& a, const agent2d::PlayerView& b) {
-              return (a.pos - w.ball_pos).r2() < (b.pos - w.ball_pos).r2();
-            });
+  // Nearest to the ball first (WorldModel::opponentsFromBall); an insertion sort of at most
+  // kMaxOpponents entries.
+  for (int i = 1; i < w.num_opponents; ++i) {
+    const agent2d::PlayerView o = w.opponents[i];
+    const double d = (o.pos - w.ball_pos).r2();
+    int j = i;
+    for (; j > 0 && (w.opponents[j - 1].pos - w.ball_pos).r2() > d; --j) {
+      w.opponents[j] = w.opponents[j - 1];
+    }
+    w.opponents[j] = o;
+  }
   w.finish();
   return w;
 }
 
-GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
-  const GoalieWorld w = goalie_world(s, goalie);
-  g_goalie_rule[0] = 0;
+GoalieCommand decide_goalie(const SoccerState& s, int goalie, bool server_noise) {
+  const GoalieWorld w = goalie_world(s, goalie, server_noise);
   if (w.self.frozen) {
     return {};  // librcsc refuses every body command while the tackle freezes the player
   }
@@ -556,14 +580,8 @@ GoalieCommand decide_goalie(const SoccerState& s, int goalie) {
     return {GoalieCommand::Kind::kKick, kMaxKickPower, dir};
   }
   InterceptTable table;
-  agent2d::predict_intercepts(w, &table);
+  agent2d::predict_ball_and_opponents(w, &table);
   const Context c{w, table, &out};
-  {
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "self=%d opp=%d kick_opp=%d ", table.self_reach_cycle, table.opponent_reach_cycle,
-                  w.exist_kickable_opponent);
-    std::strncat(g_goalie_rule, buf, 200);
-  }
   if (ball_chase_situation(c)) {
     chase_ball(c);
   } else {

@@ -31,11 +31,13 @@ namespace pamdp::hfo {
 
 using GoalieCommand = agent2d::Command;
 
-// The goalie's world model, mirrored into its own frame (goalie_world.hpp).
-agent2d::GoalieWorld goalie_world(const SoccerState& state, int goalie);
+// The goalie's world model, mirrored into its own frame (goalie_world.hpp). `server_noise`
+// says whether the server runs with its noise parameters (SoccerSimConfig::noise) or with
+// them at 0, which the goalie reads from the server as the real one does.
+agent2d::GoalieWorld goalie_world(const SoccerState& state, int goalie, bool server_noise);
 
 // The goalie's command for this cycle; `goalie` indexes state.players.
-GoalieCommand decide_goalie(const SoccerState& state, int goalie);
+GoalieCommand decide_goalie(const SoccerState& state, int goalie, bool server_noise);
 
 // The command's name as the server's log writes it (DASH, TURN, CATCH, KICK, TACKLE, NONE).
 const char* goalie_command_name(GoalieCommand::Kind kind);

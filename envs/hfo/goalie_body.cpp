@@ -41,35 +41,6 @@ double first_term_geom_series(double sum, double r, int len) {
   return sum * (1.0 - r) / (1.0 - std::pow(r, len));
 }
 
-// librcsc StaminaModel (common/stamina_model.cpp): simulateWait and simulateDash.
-struct StaminaSim {
-  double stamina;
-  double effort;
-  double recovery;
-  double capacity;
-
-  void wait() {
-    if (stamina <= kRecoverDecThreshold && recovery > kRecoverMin) {
-      recovery = std::max(kRecoverMin, recovery - kRecoverDec);
-    }
-    if (stamina <= kEffortDecThreshold) {
-      if (effort > kEffortMin) {
-        effort = std::max(kEffortMin, effort - kEffortDec);
-      }
-    } else if (stamina >= kEffortIncThreshold && effort < kEffortMax) {
-      effort = std::min(kEffortMax, effort + kEffortInc);
-    }
-    const double inc = std::min(kStaminaIncMax * recovery, kStaminaMax - stamina);
-    stamina += std::min(inc, capacity);
-    capacity = std::max(0.0, capacity - inc);
-    stamina = std::min(stamina, kStaminaMax);
-  }
-  void dash(double power) {
-    stamina = std::max(0.0, stamina - (power >= 0.0 ? power : -2.0 * power));
-    wait();
-  }
-};
-
 // Number of points where the segment a-b meets the circle (Circle2D::intersection with a
 // Segment2D: the line's solutions that the segment contains).
 int segment_circle_points(Vec2 a, Vec2 b, Vec2 c, double r) {
@@ -208,10 +179,10 @@ bool adjust_dash(const GoalieWorld& w, Vec2 target, double dist_thr, double max_
     const double rate = dash_rate(w) * dash_dir_rate(dir);
     const int max_cycle = std::min(3, cycle_n);
     Vec2 my_vel = rel_vel;
-    StaminaSim stamina{w.self.stamina, w.self.effort, w.self.recovery, w.self.capacity};
+    StaminaModel stamina = stamina_of(w.self);
     double first_power = kIllegalPower;
     // PlayerType::inertiaPoint from the origin with the relative velocity.
-    Vec2 my_pos = rel_vel * ((1.0 - std::pow(kPlayerDecay, cycle_n)) / (1.0 - kPlayerDecay));
+    Vec2 my_pos = rel_vel * ((1.0 - player_decay_pow(cycle_n)) / (1.0 - kPlayerDecay));
     int c = 0;
     for (; c < max_cycle; ++c) {
       const Vec2 required_move = rotate(target_rel - my_pos, -dash_angle);

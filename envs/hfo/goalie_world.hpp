@@ -11,7 +11,9 @@
 // Nothing here allocates; every call is O(intercept horizon) at most.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "envs/hfo/geometry.hpp"
@@ -67,10 +69,10 @@ struct GoalieWorld {
   int num_opponents = 0;
   // Cycles since the goalie's last catch command; a large value when it has not caught.
   int since_catch = 1000;
-  // The server's ball_rand and player_rand as the client reads them (ServerParam): librcsc's
-  // intercept margins shrink with them. The recorded real games ran with both 0 (noise off).
-  double ball_rand = kBallRand;
+  // The server's noise parameters, which librcsc reads from the server and builds into its
+  // intercept margins (player_rand, ball_rand): 0.1 and 0.05 by default, 0 with noise off.
   double player_rand = kPlayerRand;
+  double ball_rand = kBallRand;
 
   // Derived values, as librcsc computes them (set by finish(), which the builder calls).
   double ball_dist_from_self = 0.0;
@@ -88,7 +90,7 @@ struct InterceptInfo {
   int turn_cycle = 10000;
   int dash_cycle = 10000;
   double dash_power = 100000.0;
-  double dash_angle_deg = 0.0;  // first dash direction relative to the body (librcsc dashAngle)
+  double dash_angle_deg = 0.0;  // first dash direction, global (in the goalie's frame)
   Vec2 self_pos{-10000.0, 0.0};
   double ball_dist = 10000000.0;
   double stamina = 0.0;
@@ -99,7 +101,7 @@ struct InterceptInfo {
 // opponents' and teammates' reach cycles (1000 = cannot within the horizon).
 struct InterceptTable {
   static constexpr int kMaxCycle = 30;  // InterceptTable::MAX_CYCLE
-  static constexpr int kMaxSelfCache = 2 * (kMaxCycle + 2);
+  static constexpr int kMaxSelfCache = 3 * (kMaxCycle + 2);
   std::array<Vec2, kMaxCycle + 2> ball_cache{};
   int ball_cache_size = 0;
   std::array<InterceptInfo, kMaxSelfCache> self_cache{};
@@ -108,11 +110,64 @@ struct InterceptTable {
   int self_exhaust_reach_cycle = 1000;
   int opponent_reach_cycle = 1000;
   int teammate_reach_cycle = 1000;  // HFO's defense has no field players here: always 1000
+  bool self_predicted = false;      // predict_self() has filled the self_* members
 };
 
-// Fills `table` from `world` (InterceptTable::update with SelfInterceptV13 and
-// PlayerIntercept). Implemented in goalie_intercept.cpp.
-void predict_intercepts(const GoalieWorld& world, InterceptTable* table);
+// librcsc StaminaModel (common/stamina_model.cpp): simulateWait and simulateDash of player type 0.
+struct StaminaModel {
+  double stamina = kStaminaMax;
+  double effort = 1.0;
+  double recovery = 1.0;
+  double capacity = kStaminaCapacity;
+
+  void wait() {
+    if (stamina <= kRecoverDecThreshold && recovery > kRecoverMin) {
+      recovery = std::max(kRecoverMin, recovery - kRecoverDec);
+    }
+    if (stamina <= kEffortDecThreshold) {
+      if (effort > kEffortMin) {
+        effort = std::max(kEffortMin, effort - kEffortDec);
+      }
+    } else if (stamina >= kEffortIncThreshold && effort < kEffortMax) {
+      effort = std::min(kEffortMax, effort + kEffortInc);
+    }
+    const double inc = std::min(kStaminaIncMax * recovery, kStaminaMax - stamina);
+    stamina += std::min(inc, capacity);
+    capacity = std::max(0.0, capacity - inc);
+    stamina = std::min(stamina, kStaminaMax);
+  }
+  void waits(int n) {
+    for (int i = 0; i < n; ++i) {
+      wait();
+    }
+  }
+  void dash(double power) {
+    stamina = std::max(0.0, stamina - (power >= 0.0 ? power : -2.0 * power));
+    wait();
+  }
+  void dashes(int n, double power) {
+    for (int i = 0; i < n; ++i) {
+      dash(power);
+    }
+  }
+  [[nodiscard]] bool capacity_is_empty() const { return capacity <= 1.0e-5 && capacity >= 0.0; }
+};
+
+inline StaminaModel stamina_of(const SelfView& s) {
+  return {s.stamina, s.effort, s.recovery, s.capacity};
+}
+
+// InterceptTable::update in two parts (goalie_intercept.cpp): the ball's path and the
+// opponents' reach (PlayerIntercept), which every cycle needs, and the goalie's own ways to the
+// ball (SelfInterceptV13), which only some rules read, so the goalie computes them on demand.
+void predict_ball_and_opponents(const GoalieWorld& world, InterceptTable* table);
+void predict_self(const GoalieWorld& world, InterceptTable* table);
+// PlayerType::cyclesToReachDistance for player type 0 (full dashes from rest).
+int cycles_to_reach_distance(double dash_dist);
+inline void predict_intercepts(const GoalieWorld& world, InterceptTable* table) {
+  predict_ball_and_opponents(world, table);
+  predict_self(world, table);
+}
 
 // --- Commands, in the server's units (what the .rcl logs) -------------------------------
 
@@ -148,13 +203,33 @@ bool go_to_point_look_ball(const GoalieWorld& w, Vec2 target, double dist_thr, d
 // Body_Intercept2009 (implemented in goalie_intercept.cpp).
 bool body_intercept(const GoalieWorld& w, const InterceptTable& table, bool save_recovery, Command* out);
 
+// decay^n for the inertia sums, the same values std::pow gives, looked up for small n.
+struct DecayPowers {
+  static constexpr int kSize = 128;
+  std::array<double, kSize> ball{};
+  std::array<double, kSize> player{};
+  DecayPowers() {
+    for (int n = 0; n < kSize; ++n) {
+      ball[static_cast<size_t>(n)] = std::pow(kBallDecay, n);
+      player[static_cast<size_t>(n)] = std::pow(kPlayerDecay, n);
+    }
+  }
+};
+inline const DecayPowers kDecayPowers;
+inline double ball_decay_pow(int n) {
+  return n >= 0 && n < DecayPowers::kSize ? kDecayPowers.ball[static_cast<size_t>(n)] : std::pow(kBallDecay, n);
+}
+inline double player_decay_pow(int n) {
+  return n >= 0 && n < DecayPowers::kSize ? kDecayPowers.player[static_cast<size_t>(n)] : std::pow(kPlayerDecay, n);
+}
+
 // Ball and player inertia helpers (librcsc inertia_n_step_point and friends).
 inline Vec2 ball_inertia_point(const GoalieWorld& w, int n) {
-  const double k = (1.0 - std::pow(kBallDecay, n)) / (1.0 - kBallDecay);
+  const double k = (1.0 - ball_decay_pow(n)) / (1.0 - kBallDecay);
   return w.ball_pos + w.ball_vel * k;
 }
 inline Vec2 self_inertia_point(const GoalieWorld& w, int n) {
-  const double k = (1.0 - std::pow(kPlayerDecay, n)) / (1.0 - kPlayerDecay);
+  const double k = (1.0 - player_decay_pow(n)) / (1.0 - kPlayerDecay);
   return w.self.pos + w.self.vel * k;
 }
 inline Vec2 self_inertia_final_point(const GoalieWorld& w) {

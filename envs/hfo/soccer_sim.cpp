@@ -384,7 +384,7 @@ void SoccerSim::sense_goalie() {
   if (!config_.goalie || goalie_sensed_) {
     return;
   }
-  const GoalieCommand c = decide_goalie(state_, kGoalieIndex);
+  const GoalieCommand c = decide_goalie(state_, kGoalieIndex, config_.noise);
   pending_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
   goalie_sensed_ = true;
 }
