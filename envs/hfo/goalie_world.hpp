@@ -90,7 +90,7 @@ struct InterceptInfo {
   int turn_cycle = 10000;
   int dash_cycle = 10000;
   double dash_power = 100000.0;
-  double dash_angle_deg = 0.0;  // first dash direction, global (in the goalie's frame)
+  double dash_angle_deg = 0.0;  // first dash direction relative to the body (librcsc dashAngle)
   Vec2 self_pos{-10000.0, 0.0};
   double ball_dist = 10000000.0;
   double stamina = 0.0;
