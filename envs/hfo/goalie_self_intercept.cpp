@@ -100,20 +100,14 @@ class SelfIntercept {
     predict_short_step(max_cycle, save_recovery);
     predict_long_step(max_cycle, save_recovery);
     predict_long_step(max_cycle, false);
-    // InterceptInfo::Cmp: reach cycle, then turn cycle. An insertion sort keeps equal entries
-    // in order and allocates nothing (std::stable_sort may).
-    auto before = [](const InterceptInfo& a, const InterceptInfo& b) {
-      return a.reach_cycle() < b.reach_cycle() || (a.reach_cycle() == b.reach_cycle() && a.turn_cycle < b.turn_cycle);
-    };
-    InterceptInfo* c = t_->self_cache.data();
-    for (int i = 1; i < t_->self_cache_size; ++i) {
-      const InterceptInfo x = c[i];
-      int j = i;
-      for (; j > 0 && before(x, c[j - 1]); --j) {
-        c[j] = c[j - 1];
-      }
-      c[j] = x;
-    }
+    // std::sort with InterceptInfo::Cmp (reach cycle, then turn cycle), as librcsc: with more
+    // than 16 entries libstdc++'s introsort reorders equal ones, and Body_Intercept2009 keeps the
+    // first of equal scores, so a stable sort can pick another way. std::sort allocates nothing.
+    std::sort(t_->self_cache.begin(), t_->self_cache.begin() + t_->self_cache_size,
+              [](const InterceptInfo& a, const InterceptInfo& b) {
+                return a.reach_cycle() < b.reach_cycle() ||
+                       (a.reach_cycle() == b.reach_cycle() && a.turn_cycle < b.turn_cycle);
+              });
   }
 
  private:
@@ -280,10 +274,11 @@ class SelfIntercept {
   }
 
   // getOneStepDashPower; note that librcsc passes the global dash angle where it reads a
-  // relative direction for the dash rate, which we keep.
+  // relative direction for the dash rate, which we keep. ServerParam::dashDirRate clamps and
+  // discretizes its argument first (common/server_param.cpp), which matters for this angle.
   [[nodiscard]] double one_step_dash_power(Vec2 next_ball_rel, double dash_angle, double max_forward_accel_x,
                                            double max_back_accel_x) const {
-    const double rate = dash_rate() * dash_dir_rate(dash_angle);
+    const double rate = dash_rate() * dash_dir_rate(discretize_dash_dir(clamp(dash_angle, -180.0, 180.0)));
     const double best_forward = kPlayerSize + 0.5 * kKickableMargin + kBallSize;
     const double best_backward = kPlayerSize + 0.3 * kKickableMargin + kBallSize;
     if (std::fabs(next_ball_rel.y) > best_forward) {
