@@ -184,6 +184,52 @@ TEST(GoalieIntercept, KickableOpponentCloseByIsAttacked) {
   EXPECT_DOUBLE_EQ(c.p2, 0.0);
 }
 
+// getOneStepDashPower divides by dashDirRate of the global dash angle (librcsc passes it for
+// a relative one), and ServerParam::dashDirRate discretizes first: 12.5 degrees becomes 0 and
+// the rate 1, so the one dash straight ahead is the wanted acceleration / 0.006. Without the
+// discretization the rate would be 0.4 + 0.6 (1 - 12.5 / 90) = 0.917 and the power 98.64.
+// (A state where two independent ports first disagreed.)
+TEST(GoalieIntercept, OneStepDashRateDiscretizesTheGlobalAngle) {
+  GoalieWorld w = world({-42.605221884983081, -8.3356815769333288}, 12.51567821915782,
+                        {-42.019554580501833, -6.383216969855571}, {-0.2716937026711323, -0.86361212902227169});
+  w.ball_rand = kBallRand;
+  w.player_rand = kPlayerRand;
+  add_opponent(&w, {-41.997249388391197, -10.274543660642859}, -113.20959439084903);
+  InterceptTable t;
+  predict_intercepts(w, &t);
+  ASSERT_EQ(t.self_reach_cycle, 1);
+  EXPECT_EQ(t.self_cache[0].turn_cycle, 0);
+  EXPECT_EQ(t.self_cache[0].dash_cycle, 1);
+  EXPECT_NEAR(t.self_cache[0].dash_power, 90.412, 1e-3);
+  Command c;
+  ASSERT_TRUE(body_intercept(w, t, false, &c));
+  EXPECT_EQ(c.kind, Command::Kind::kDash);
+  EXPECT_DOUBLE_EQ(c.p1, 90.412);
+}
+
+// 22 ways to the ball, with pairs of equal reach and turn count (a wait and a dash each
+// cycle): librcsc sorts them with std::sort, whose introsort reorders equal entries past 16,
+// and Body_Intercept2009 keeps the first of equal scores. Here that is a full dash at cycle 12
+// (goalie branch, ball 0.2 m away), not the wait that a stable sort would leave first (which
+// would turn instead).
+TEST(GoalieIntercept, SelfCacheOrderFollowsStdSort) {
+  GoalieWorld w = world({-49.33550910745609, -9.1216689793570431}, -7.0122837070174739,
+                        {-52.392900175414731, -6.4156341049677685}, {0.77424116943124233, -0.3848604957370888});
+  w.self.stamina = 2360.8042519081896;
+  add_opponent(&w, {-56.910325001261057, -1.6198358102319599}, -135.70499943892764);
+  w.opponents[0].vel = {0.030303765206168176, -0.011217222109090874};
+  w.finish();
+  InterceptTable t;
+  predict_intercepts(w, &t);
+  ASSERT_EQ(t.self_cache_size, 22);
+  EXPECT_EQ(t.opponent_reach_cycle, 16);
+  Command c;
+  ASSERT_TRUE(body_intercept(w, t, false, &c));
+  EXPECT_EQ(c.kind, Command::Kind::kDash);
+  EXPECT_DOUBLE_EQ(c.p1, 100.0);
+  EXPECT_DOUBLE_EQ(c.p2, 0.0);
+}
+
 TEST(GoalieIntercept, CountingAllocatorSeesAllocations) {
   long n = 0;
   {
