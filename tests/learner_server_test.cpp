@@ -281,6 +281,47 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   wire::build_join_request(fbb, wire::Role::Actor, "intruder", "", "", 1);
   (void)bad_join.send(wire::bytes_of(fbb), 200);  // queued until a handshake that never succeeds
 
+  // The refusal table (docs/reliability.md), one intruder at a time so that each is seen counted:
+  // no key at all (a plain SUB, a plain actor, a plain shard), a key the cluster did not issue, and
+  // the cluster's own client key with another server public key.
+  auto refused_more_than = [&](int64_t before) {
+    const auto until = Clock::now() + std::chrono::seconds(5);
+    while (server.connections_refused() <= before && Clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return server.connections_refused() > before;
+  };
+  ASSERT_TRUE(refused_more_than(1)) << "the two foreign-key intruders: " << server.connections_refused();
+  net::Socket plain_sub(ctx, net::SocketType::kSub);
+  int64_t before = server.connections_refused();
+  plain_sub.subscribe_all();
+  plain_sub.connect(server.weights_endpoint());
+  EXPECT_TRUE(refused_more_than(before)) << "a plain SUB on the weights socket was not counted";
+  std::vector<net::Socket> intruders;
+  const std::string nowhere = "tcp://127.0.0.1:1";
+  const net::CurveServerKeys other_server = net::generate_curve_keypair();
+  const net::CurveClientKeys wrong_server{cluster_client.public_key, cluster_client.secret_key,
+                                          other_server.public_key};
+  for (int kind = 0; kind < 4; ++kind) {
+    before = server.connections_refused();
+    intruders.emplace_back(ctx, net::SocketType::kDealer);
+    net::Socket& s = intruders.back();
+    if (kind == 2) {
+      s.make_curve_client(bad);
+    } else if (kind == 3) {
+      s.make_curve_client(wrong_server);
+    }
+    s.connect(server.join_endpoint());
+    if (kind == 0) {
+      wire::build_join_request(fbb, wire::Role::Actor, "plain-actor", "", "", 1);
+    } else {
+      wire::build_join_request(fbb, wire::Role::Shard, "intruding-shard", nowhere, nowhere, 0);
+    }
+    (void)s.send(wire::bytes_of(fbb), 200);
+    EXPECT_TRUE(refused_more_than(before)) << "intruder " << kind << " (0 plain actor, 1 plain shard, 2 foreign "
+                                           << "key shard, 3 wrong server key shard) was not counted";
+  }
+
   // A shard with the cluster's key: its sample socket is a CURVE server with the cluster's keys.
   net::Socket sample(ctx, net::SocketType::kRouter);
   sample.make_curve_server(server_keys);
@@ -291,7 +332,10 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
   ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
   net::Message m;
-  ASSERT_NE(await_payload(join, m, wire::Payload::ClusterMap), nullptr);
+  const wire::Envelope* map_env = await_payload(join, m, wire::Payload::ClusterMap);
+  ASSERT_NE(map_env, nullptr);
+  EXPECT_EQ(map_env->payload_as_ClusterMap()->shard_sample_endpoints()->size(), 1U)
+      << "an intruding shard is in the map";
 
   // Serve samples until the run ends; the good subscriber counts what it receives meanwhile.
   std::vector<float> states(kBatch * kObs, 0.1F);
@@ -323,7 +367,14 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   EXPECT_GT(received, 10) << "the subscriber with the cluster's key got " << received << " publications";
   EXPECT_FALSE(bad_sub.recv(m, 300)) << "a subscriber with a foreign key received weights";
   EXPECT_FALSE(bad_join.recv(m, 300)) << "a joiner with a foreign key was answered";
-  EXPECT_GE(auth.refused(), 2);
+  EXPECT_FALSE(plain_sub.recv(m, 100)) << "a plain subscriber received weights";
+  for (net::Socket& s : intruders) {
+    EXPECT_FALSE(s.recv(m, 100)) << "an intruding joiner was answered";
+  }
+  EXPECT_GE(auth.refused(), 3);  // the ZAP handler sees only the foreign client keys
+  EXPECT_GE(server.connections_refused(), 7);
+  EXPECT_GE(server.counters().connections_refused, 7);  // as the metrics see it
+  EXPECT_EQ(server.counters().shards, 1);
   EXPECT_EQ(server.counters().actors_alive, 0);
   EXPECT_EQ(server.counters().malformed_messages, 0);
 }

@@ -553,8 +553,25 @@ TEST(ShardServer, CurveRefusesForeignKeysOnBothSockets) {
   wire::build_sample_request(fbb, 1, 8);
   (void)raw_sampler.send(wire::bytes_of(fbb), 200);
   EXPECT_TRUE(eventually([&] { return auth.refused() >= 2; })) << "refused " << auth.refused();
+  EXPECT_TRUE(eventually([&] { return shard.server().counters().connections_refused >= 2; }));
+  // Plain DEALERs (no CURVE at all) on each socket: refused in the handshake, and counted.
+  net::Socket plain_actor(ctx, net::SocketType::kDealer);
+  int64_t before = shard.server().counters().connections_refused;
+  plain_actor.connect(shard.server().insert_endpoint());
+  wire::build_transition_batch(fbb, 10, 0, rows.view());
+  (void)plain_actor.send(wire::bytes_of(fbb), 200);
+  EXPECT_TRUE(eventually([&] { return shard.server().counters().connections_refused > before; }))
+      << "a plain DEALER on the insert socket was not counted";
+  net::Socket plain_sampler(ctx, net::SocketType::kDealer);
+  before = shard.server().counters().connections_refused;
+  plain_sampler.connect(shard.server().sample_endpoint());
+  wire::build_sample_request(fbb, 2, 8);
+  (void)plain_sampler.send(wire::bytes_of(fbb), 200);
+  EXPECT_TRUE(eventually([&] { return shard.server().counters().connections_refused > before; }))
+      << "a plain DEALER on the sample socket was not counted";
   net::Message reply;
   EXPECT_FALSE(raw_sampler.recv(reply, 300)) << "an unauthenticated sampler got an answer";
+  EXPECT_FALSE(plain_sampler.recv(reply, 100)) << "a plain sampler got an answer";
   EXPECT_EQ(shard.server().counters().inserted, 0);
   EXPECT_EQ(shard.server().counters().malformed, 0);
 
