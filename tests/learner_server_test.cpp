@@ -6,11 +6,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/rng.hpp"
 #include "core/transport.hpp"
 #include "core/wire.hpp"
 #include "envs/toy/reach_stop.hpp"
@@ -179,6 +181,47 @@ const wire::Envelope* await_payload(net::Socket& s, net::Message& m, wire::Paylo
     }
   }
   return nullptr;
+}
+
+// The probe of issue 33 at the learner's join socket, bounded and on loopback: 2,000 random
+// frames (empty, 1-7 bytes, short ones with the schema's identifier, up to 4 KB) from one DEALER,
+// then a MetricsUrlsRequest; the join socket reads one peer's frames in order, so once its answer
+// comes every frame before it has been handled, and each must have been counted.
+TEST(LearnerServer, EveryRandomFrameAtTheJoinSocketIsCounted) {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
+  LearnerServer server(ctx, backend, loopback_config());
+  std::thread thread([&] { server.run(); });
+  net::Socket probe(ctx, net::SocketType::kDealer);
+  probe.connect(server.join_endpoint());
+  Rng rng(33);
+  constexpr int kFrames = 2000;
+  std::vector<uint8_t> frame;
+  for (int i = 0; i < kFrames; ++i) {
+    const int kind = i % 10;
+    const size_t size = kind == 0   ? 0
+                        : kind == 1 ? 1 + rng.next_u64() % 7
+                        : kind <= 4 ? 8 + rng.next_u64() % 57
+                                    : rng.next_u64() % 4097;
+    frame.resize(size);
+    for (uint8_t& b : frame) {
+      b = static_cast<uint8_t>(rng.next_u64());
+    }
+    if (kind >= 2 && kind <= 4) {
+      std::memcpy(frame.data() + 4, "PMSG", 4);  // the envelope's file identifier
+    }
+    ASSERT_TRUE(probe.send(frame, 2000)) << "frame " << i;
+  }
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_metrics_urls_request(fbb);
+  ASSERT_TRUE(probe.send(wire::bytes_of(fbb), 2000));
+  net::Message m;
+  EXPECT_NE(await_payload(probe, m, wire::Payload::MetricsUrls), nullptr);
+  server.stop();
+  thread.join();
+  EXPECT_EQ(server.counters().malformed_messages, kFrames);
 }
 
 TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {

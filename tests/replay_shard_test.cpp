@@ -779,6 +779,102 @@ TEST(ShardServer, MalformedMessagesAreDroppedAndCounted) {
   EXPECT_EQ(shard.error(), "");
 }
 
+// Random frames of every length (0, 1-7 bytes, short ones with the schema's identifier so that
+// they reach the verifier, up to 4 KB), from a fixed seed.
+std::vector<std::vector<uint8_t>> random_frames(int n, uint64_t seed) {
+  Rng rng(seed);
+  std::vector<std::vector<uint8_t>> frames(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    size_t size = 0;
+    switch (i % 10) {
+      case 0: size = 0; break;
+      case 1: size = 1 + rng.next_u64() % 7; break;
+      case 2:
+      case 3:
+      case 4: size = 8 + rng.next_u64() % 57; break;
+      default: size = rng.next_u64() % 4097; break;
+    }
+    std::vector<uint8_t>& f = frames[static_cast<size_t>(i)];
+    f.resize(size);
+    for (uint8_t& b : f) {
+      b = static_cast<uint8_t>(rng.next_u64());
+    }
+    if (i % 10 >= 2 && i % 10 <= 4) {
+      std::memcpy(f.data() + 4, "PMSG", 4);  // the envelope's file identifier
+    }
+  }
+  return frames;
+}
+
+// The probe of issue 33, bounded and on loopback: every random frame sent to the insert and
+// sample sockets is counted as malformed, empty and 1-7 byte frames included. Frames sent before
+// the shard joined, or while its rate limiter holds inserts back, wait unread in ZeroMQ's queues
+// (backpressure by design) and are counted when the shard reads them, none lost: this is what a
+// live probe that saw 9,137 of 15,000 counted "within seconds" was looking at.
+TEST(ShardServer, EveryRandomFrameIsCountedOnceRead) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  // spi 1, min_size 1, slack 1: after 3 transitions inserts wait for 3 samples.
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config(1.0, 1, 1)));
+  auto counters = [&] { return shard.server().counters(); };
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  FakeSampler sampler(ctx, shard.server().sample_endpoint());
+  const auto frames = random_frames(3000, 33);
+  size_t next = 0;
+  auto send = [&](FakeActor* a, FakeSampler* s, int n) {
+    for (int i = 0; i < n; ++i, ++next) {
+      if (a != nullptr) {
+        a->send_raw(frames[next]);
+      } else {
+        s->send_raw(frames[next]);
+      }
+    }
+  };
+  constexpr int kSettleMs = 200;  // long enough for a read that should not happen to show
+
+  // Before joining: nothing is read, nothing counted.
+  send(&actor, nullptr, 200);
+  send(nullptr, &sampler, 100);
+  std::this_thread::sleep_for(std::chrono::milliseconds(kSettleMs));
+  EXPECT_EQ(counters().malformed, 0);
+  join(learner, shard);
+  ASSERT_TRUE(eventually([&] { return counters().malformed == 300; }, 10000)) << counters().malformed << " of 300";
+
+  // Inserts held back: frames on the insert socket wait, those on the sample socket are counted.
+  actor.insert(make_rows(3, 0.0F));
+  ASSERT_TRUE(eventually([&] { return counters().inserted == 3 && counters().inserts_held == 1; }));
+  send(&actor, nullptr, 500);
+  send(nullptr, &sampler, 500);
+  ASSERT_TRUE(eventually([&] { return counters().malformed == 800; }, 10000)) << counters().malformed << " of 800";
+  std::this_thread::sleep_for(std::chrono::milliseconds(kSettleMs));
+  EXPECT_EQ(counters().malformed, 800) << "frames behind backpressure were read";
+  // A sample of 3 releases the inserts: the 500 waiting frames are read and counted.
+  sampler.request(1, 3);
+  ASSERT_NE(sampler.reply(), nullptr);
+  ASSERT_TRUE(eventually([&] { return counters().malformed == 1300; }, 10000)) << counters().malformed << " of 1300";
+
+  // The rest on both sockets at once.
+  FakeActor actor2(ctx, shard.server().insert_endpoint());
+  std::thread other([&] {
+    for (size_t i = 2500; i < frames.size(); ++i) {
+      actor2.send_raw(frames[i]);
+    }
+  });
+  for (int i = 0; i < 600; ++i) {
+    if (i % 2 == 0) {
+      actor.send_raw(frames[next]);
+    } else {
+      sampler.send_raw(frames[next]);
+    }
+    ++next;
+  }
+  other.join();
+  ASSERT_TRUE(eventually([&] { return counters().malformed == 2400; }, 10000)) << counters().malformed << " of 2400";
+  EXPECT_EQ(counters().inserted, 3);
+  EXPECT_TRUE(sampler.nothing_queued());
+  EXPECT_EQ(shard.error(), "");
+}
+
 TEST(ShardServer, OversizedFramesNeverReachTheShard) {
   net::Context ctx;
   FakeLearner learner(ctx);
