@@ -17,6 +17,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/network_security.hpp"
 #include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
@@ -37,6 +38,7 @@ struct ActorCliOptions {
   bool apex_epsilon = false;
   std::string name;
   std::string curve_keys;
+  bool insecure = false;
   double join_timeout_s = 30.0;
   double progress_every_s = 5.0;
   std::string metrics_bind = "127.0.0.1";
@@ -54,6 +56,15 @@ std::string default_name() {
 }
 
 void run_actor(const ActorCliOptions& o) {
+  // An actor binds nothing, but without CURVE what it sends and the weights it acts with cross the
+  // network in the clear and unauthenticated.
+  const SecurityOptions security{"pamdp actor", "--curve-keys keys here, the learner with --set cluster.curve=true",
+                                 "--insecure here (and --set cluster.insecure=true on the learner)",
+                                 "join a learner on this machine (--join tcp://127.0.0.1:PORT)",
+                                 "its transitions and the weights it acts with would cross the network unauthenticated "
+                                 "and in the clear, open to anyone on the path"};
+  const std::vector<ClusterEndpoint> endpoints{{"--join", o.join}};
+  const bool insecure = check_network_exposure(security, endpoints, !o.curve_keys.empty(), o.insecure);
   std::signal(SIGINT, on_actor_signal);
   std::signal(SIGTERM, on_actor_signal);
   net::Context ctx;
@@ -72,6 +83,7 @@ void run_actor(const ActorCliOptions& o) {
   ActorCounters counters;
   MetricsEndpoint endpoint("actor", link_config.name, o.metrics_bind, o.metrics_port, "");
   link_config.metrics_url = endpoint.url();
+  export_security_mode(endpoint.registry(), security, insecure, endpoints);
   LearnerLink link(ctx, link_config);
   const std::optional<ClusterInfo> map = link.join(g_stop);
   if (!map) {
@@ -170,6 +182,9 @@ void register_actor(CLI::App& app) {
   cmd->add_option("--curve-keys", o->curve_keys,
                   "directory with client.keys from pamdp keygen: CURVE on every connection (the learner must run "
                   "with cluster.curve = true)");
+  cmd->add_flag("--insecure", o->insecure,
+                "allow a learner beyond loopback without CURVE, on a trusted private network only (warned once, "
+                "exported as pamdp_security_insecure)");
   cmd->add_option("--join-timeout", o->join_timeout_s,
                   "exit with an error if the learner has not answered within this many seconds (0: keep trying)")
       ->check(CLI::Range(0.0, 86400.0))

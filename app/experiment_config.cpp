@@ -107,6 +107,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("cluster.peer_timeout_ms", c.cluster.peer_timeout_ms, 100, 3600000);
   v.boolean("cluster.curve", c.cluster.curve);
   v.text("cluster.curve_keys_dir", c.cluster.curve_keys_dir);
+  v.boolean("cluster.insecure", c.cluster.insecure);
 
   v.text("metrics.bind", c.metrics.bind);
   v.integer("metrics.port", c.metrics.port, 0, 65535);

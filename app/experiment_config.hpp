@@ -47,9 +47,11 @@ struct ReplayConfig {
 
 // The distributed system (docs/protocol.md). Endpoints are ZeroMQ addresses.
 struct ClusterConfig {
-  std::string learner_bind = "tcp://*:5555";  // join socket (ROUTER)
-  std::string weights_bind = "tcp://*:5556";  // weights broadcast (PUB)
-  std::string advertise_host = "127.0.0.1";   // how peers reach this machine's bound ports
+  // Loopback by default. Any other address needs CURVE (curve = true) or insecure = true, or the
+  // learner refuses to start (docs/protocol.md, "Security").
+  std::string learner_bind = "tcp://127.0.0.1:5555";  // join socket (ROUTER)
+  std::string weights_bind = "tcp://127.0.0.1:5556";  // weights broadcast (PUB)
+  std::string advertise_host = "127.0.0.1";           // how peers reach this machine's bound ports
   int64_t publish_every_updates = 100;
   int actor_batch_transitions = 64;  // transitions per TransitionBatch message
   // Samples per inserted transition the shards allow (0: updates_per_step * batch_size, the
@@ -61,6 +63,9 @@ struct ClusterConfig {
   int peer_timeout_ms = 5000;
   bool curve = false;                   // CURVE encryption + authentication on every socket
   std::string curve_keys_dir = "keys";  // written by pamdp keygen
+  // Binds beyond loopback without CURVE, for a trusted private network: warned once at start-up
+  // and exported as pamdp_security_insecure = 1. Shards and actors take --insecure.
+  bool insecure = false;
 };
 
 // The /metrics endpoint of `pamdp learner` and `pamdp train` (actors and shards take

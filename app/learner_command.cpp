@@ -18,6 +18,7 @@
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "app/network_security.hpp"
 #include "app/role_metrics.hpp"
 #include "app/run_logs.hpp"
 #include "app/run_options.hpp"
@@ -77,6 +78,18 @@ void run_learner(const LearnerCliOptions& o) {
         ": demonstrations are played by pamdp train only, the cluster's actors do not play them; set "
         "exploration.demo_fraction = 0 (--set exploration.demo_fraction=0) or train with pamdp train");
   }
+  // Before anything is written or bound: no cluster socket on the network without CURVE unless
+  // asked for.
+  const SecurityOptions security{
+      "learner",
+      "--set cluster.curve=true --set cluster.curve_keys_dir=keys here and --curve-keys keys on every "
+      "pamdp replay and pamdp actor",
+      "--set cluster.insecure=true here and --insecure on every pamdp replay and pamdp actor",
+      "bind tcp://127.0.0.1:PORT (the default)"};
+  const std::vector<ClusterEndpoint> binds{{"cluster.learner_bind", c.cluster.learner_bind},
+                                           {"cluster.weights_bind", c.cluster.weights_bind}};
+  const bool insecure = check_network_exposure(security, binds, c.cluster.curve, c.cluster.insecure);
+  check_advertise_host(security, "cluster.advertise_host", c.cluster.advertise_host, binds);
   fs::create_directories(run_dir);
   const std::string config_text = to_toml(c);
   if (!resume) {
@@ -117,6 +130,7 @@ void run_learner(const LearnerCliOptions& o) {
   o.apply_metrics_overrides(c);
   MetricsEndpoint endpoint("learner", "learner", c.metrics.bind, c.metrics.port, c.cluster.advertise_host);
   LearnerMetrics learner_metrics(endpoint.registry(), *env, exploration);
+  export_security_mode(endpoint.registry(), security, insecure, binds);
   sc.metrics_url = endpoint.url();
 
   net::Context ctx;
@@ -316,7 +330,7 @@ void register_learner(CLI::App& app) {
                                      "runs DDPG updates, broadcasts weights");
   add_run_options(*cmd, *o,
                   {"TOML config (default: the paper preset)",
-                   "override one config key, e.g. --set cluster.learner_bind=tcp://*:6000",
+                   "override one config key, e.g. --set cluster.learner_bind=tcp://127.0.0.1:6000",
                    "where config, metrics and checkpoints go"});
   cmd->callback([o] { run_learner(*o); });
 }

@@ -11,6 +11,7 @@
 
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
+#include "app/network_security.hpp"
 #include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
@@ -33,14 +34,15 @@ extern "C" void on_replay_signal(int /*sig*/) {
 
 struct ReplayCliOptions {
   std::string join;
-  std::string insert_bind = "tcp://*:0";
-  std::string sample_bind = "tcp://*:0";
+  std::string insert_bind = "tcp://127.0.0.1:0";
+  std::string sample_bind = "tcp://127.0.0.1:0";
   std::string advertise_host = "127.0.0.1";
   std::string snapshot;
   double snapshot_every_s = 0.0;
   double join_timeout_s = 30.0;
   std::string name;
   std::string curve_keys;
+  bool insecure = false;
   std::string metrics_bind = "127.0.0.1";
   int metrics_port = 0;
 };
@@ -54,6 +56,15 @@ std::string default_name() {
 }
 
 void run_replay(const ReplayCliOptions& o) {
+  const SecurityOptions security{
+      "pamdp replay", "--curve-keys keys here, the learner with --set cluster.curve=true",
+      "--insecure here (and --set cluster.insecure=true on the learner)",
+      "use --insert-bind and --sample-bind tcp://127.0.0.1:0 (the default) and a learner on this machine"};
+  const std::vector<ClusterEndpoint> binds{{"--insert-bind", o.insert_bind}, {"--sample-bind", o.sample_bind}};
+  std::vector<ClusterEndpoint> endpoints = binds;
+  endpoints.push_back({"--join", o.join});
+  const bool insecure = check_network_exposure(security, endpoints, !o.curve_keys.empty(), o.insecure);
+  check_advertise_host(security, "--advertise-host", o.advertise_host, binds);
   ShardServerOptions options;
   options.join_endpoint = o.join;
   options.insert_bind = o.insert_bind;
@@ -75,6 +86,7 @@ void run_replay(const ReplayCliOptions& o) {
   auto endpoint =
       std::make_unique<MetricsEndpoint>("replay", options.name, o.metrics_bind, o.metrics_port, o.advertise_host);
   options.metrics_url = endpoint->url();
+  export_security_mode(endpoint->registry(), security, insecure, endpoints);
   ShardServer server(ctx, options, shard_config_from_toml);
   register_shard_metrics(endpoint->registry(), server);
   // The endpoint's scrapes read the server: stop serving them before the server goes.
@@ -145,9 +157,13 @@ void register_replay(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "replay", "run one replay shard: joins the learner, stores actors' transitions, serves the learner's samples");
   cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")->required();
-  cmd->add_option("--insert-bind", o->insert_bind, "where actors insert (ROUTER); port 0 = any free port")
+  cmd->add_option(
+         "--insert-bind", o->insert_bind,
+         "where actors insert (ROUTER); port 0 = any free port; beyond loopback needs --curve-keys or --insecure")
       ->capture_default_str();
-  cmd->add_option("--sample-bind", o->sample_bind, "where the learner samples (ROUTER); port 0 = any free port")
+  cmd->add_option(
+         "--sample-bind", o->sample_bind,
+         "where the learner samples (ROUTER); port 0 = any free port; beyond loopback needs --curve-keys or --insecure")
       ->capture_default_str();
   cmd->add_option("--advertise-host", o->advertise_host, "the host name peers use to reach this machine's ports")
       ->capture_default_str();
@@ -166,6 +182,9 @@ void register_replay(CLI::App& app) {
   cmd->add_option("--curve-keys", o->curve_keys,
                   "directory written by pamdp keygen: encrypt and authenticate every socket with CURVE "
                   "(the learner must run with cluster.curve = true)");
+  cmd->add_flag("--insecure", o->insecure,
+                "allow binds and a learner beyond loopback without CURVE, on a trusted private network only (warned "
+                "once, exported as pamdp_security_insecure)");
   cmd->add_option("--metrics-bind", o->metrics_bind,
                   "address of this machine to serve /metrics on (0.0.0.0: every interface)")
       ->capture_default_str();

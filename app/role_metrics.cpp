@@ -17,6 +17,10 @@ using Clock = std::chrono::steady_clock;
 // Outcome codes at or above this share the "other" series (envs use a handful of small codes).
 constexpr int kMaxStatus = 64;
 
+constexpr const char* kRefusedHelp =
+    "Connections to this process's bound cluster sockets refused in the handshake (no CURVE, a wrong server key, a "
+    "client key the cluster did not issue, not ZeroMQ)";
+
 double seconds_since_epoch() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -171,6 +175,7 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
   Counter* replies_dropped =
       &r.counter("pamdp_replay_sample_replies_dropped_total", "Sample replies that could not be queued to the learner");
   Counter* bad = &r.counter("pamdp_bad_messages_total", "Received messages dropped as malformed");
+  Counter* refused = &r.counter("pamdp_connections_refused_total", kRefusedHelp);
   Counter* waits = &r.counter("pamdp_replay_rate_limiter_insert_wait_seconds_total",
                               "Time the samples-per-insert rate limiter held inserts back");
   Counter* joins = &r.counter("pamdp_replay_joins_total", "Cluster maps taken from the learner (1 + re-joins)");
@@ -188,6 +193,7 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
     dropped->set(c.transitions_dropped);
     replies_dropped->set(c.replies_dropped);
     bad->set(c.malformed);
+    refused->set(c.connections_refused);
     waits->set(c.insert_blocked_ms / 1000);
     joins->set(c.joins);
     held->set(static_cast<double>(c.inserts_held));
@@ -227,6 +233,7 @@ LearnerMetrics::LearnerMetrics(Registry& r, const Env& env, const ExplorationCon
       actors_joined_(r.counter("pamdp_learner_actors_joined_total", "Actors that joined (each counted once)")),
       waiting_(r.counter("pamdp_learner_waiting_for_data_seconds_total",
                          "Time the learner had no sampled batch to update on")),
+      refused_(r.counter("pamdp_connections_refused_total", kRefusedHelp)),
       weights_version_(r.gauge("pamdp_learner_weights_version", "Version of the newest published weights")),
       shards_(r.gauge("pamdp_learner_peers_connected", "Peers in the cluster now", {{"role", "replay"}})),
       actors_(r.gauge("pamdp_learner_peers_connected", "Peers in the cluster now", {{"role", "actor"}})),
@@ -238,6 +245,7 @@ void LearnerMetrics::on_tick(const LearnerCounters& c, int64_t updates_total, si
   bad_.set(c.malformed_messages);
   actors_joined_.set(c.actors_joined);
   waiting_.set(c.waiting_for_data_ms / 1000);
+  refused_.set(c.connections_refused);
   weights_version_.set(static_cast<double>(c.weights_version));
   shards_.set(static_cast<double>(c.shards));
   actors_.set(static_cast<double>(c.actors_alive));

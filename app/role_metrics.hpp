@@ -132,6 +132,7 @@ class LearnerMetrics {
   metrics::Counter& bad_;
   metrics::Counter& actors_joined_;
   metrics::Counter& waiting_;
+  metrics::Counter& refused_;
   metrics::Gauge& weights_version_;
   metrics::Gauge& shards_;
   metrics::Gauge& actors_;

@@ -118,6 +118,32 @@ class Socket {
 // IPv6 wildcards) becomes tcp://<host>:P; anything else is returned unchanged.
 std::string advertised_endpoint(const std::string& bound, const std::string& host);
 
+// Whether an endpoint is reachable from this machine only: inproc://, ipc://, or tcp:// on a
+// loopback address (127.0.0.0/8, [::1], localhost, the interface lo). A wildcard (tcp://*:P,
+// 0.0.0.0, [::]) and every other host count as reachable from the network.
+bool is_loopback_endpoint(const std::string& endpoint);
+
+// Counts connections whose ZMTP handshake failed on the given bound sockets: a peer without CURVE
+// at a CURVE socket (mechanism mismatch), a client that does not know the server's public key
+// (cryptographic error), a client key the CurveAuthenticator refused (ZAP 400), a peer that is not
+// ZeroMQ at all. libzmq's socket monitor (zmq_socket_monitor, events HANDSHAKE_FAILED_*) reports
+// them; one thread reads the events, logs at most once per second and counts.
+// Construct after the sockets, before binding them; destroy before them, after the thread that
+// uses them has stopped (the destructor stops monitoring on each socket).
+class HandshakeMonitor {
+ public:
+  HandshakeMonitor(Context& ctx, const std::vector<Socket*>& sockets, std::string owner);
+  ~HandshakeMonitor();
+  HandshakeMonitor(const HandshakeMonitor&) = delete;
+  HandshakeMonitor& operator=(const HandshakeMonitor&) = delete;
+  // Handshakes refused so far, all sockets; any thread.
+  [[nodiscard]] int64_t refused() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // Waits on several sockets at once; returns the indices of the readable ones.
 class Poller {
  public:

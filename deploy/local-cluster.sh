@@ -4,11 +4,13 @@
 # and on Ctrl-C stops every process it started, leaving a resumable run directory.
 #
 #   deploy/local-cluster.sh [--actors N] [--shards K] [--config FILE] [--run-dir DIR]
-#                           [--resume DIR] [--port P] [--duration SECONDS] [--set key=value ...]
+#                           [--resume DIR] [--port P] [--duration SECONDS] [--curve] [--set key=value ...]
 #
 # Defaults: one actor per core, 2 shards, deploy/configs/fast.toml, runs/cluster-<time>,
-# learner on 127.0.0.1:5555 (weights on 5556). Builds build/bin/pamdp first if it is missing
-# (PAMDP_BIN=path/to/pamdp runs another build instead).
+# learner on 127.0.0.1:5555 (weights on 5556; --port 0: any free ports). --curve encrypts and
+# authenticates every socket with CURVE, with keys made by `pamdp keygen` into RUN_DIR/keys (kept
+# for --resume). Builds build/bin/pamdp first if it is missing (PAMDP_BIN=path/to/pamdp runs
+# another build instead).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -21,9 +23,10 @@ run_dir=""
 resume=""
 port=5555
 duration=0
+curve=0
 sets=()
 
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "local-cluster: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -36,6 +39,7 @@ while [[ $# -gt 0 ]]; do
     --resume) need_value "$@"; resume=$2; shift 2 ;;
     --port) need_value "$@"; port=$2; shift 2 ;;
     --duration) need_value "$@"; duration=$2; shift 2 ;;
+    --curve) curve=1; shift ;;
     --set) need_value "$@"; sets+=(--set "$2"); shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) die "unknown option '$1' (see --help)" ;;
@@ -43,7 +47,7 @@ while [[ $# -gt 0 ]]; do
 done
 [[ $actors =~ ^[0-9]+$ && $actors -ge 1 ]] || die "--actors must be a positive integer, got '$actors'"
 [[ $shards =~ ^[0-9]+$ && $shards -ge 1 ]] || die "--shards must be a positive integer, got '$shards'"
-[[ $port =~ ^[0-9]+$ && $port -ge 1 && $port -le 65534 ]] || die "--port must be within 1..65534, got '$port'"
+[[ $port =~ ^[0-9]+$ && $port -le 65534 ]] || die "--port must be within 0..65534 (0: any free ports), got '$port'"
 [[ $duration =~ ^[0-9]+$ ]] || die "--duration must be a whole number of seconds, got '$duration'"
 if [[ -z $resume ]]; then
   [[ -f $config ]] || die "config '$config' not found (presets: deploy/configs/*.toml)"
@@ -59,14 +63,18 @@ elif [[ ! -x build/bin/pamdp ]]; then
 fi
 bin=${PAMDP_BIN:-$root/build/bin/pamdp}
 
-for p in $port $((port + 1)); do
-  if (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
-    die "port $p on 127.0.0.1 is in use (another cluster?); pick others with --port"
-  fi
-done
+if ((port > 0)); then
+  for p in $port $((port + 1)); do
+    if (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
+      die "port $p on 127.0.0.1 is in use (another cluster?); pick others with --port (0: any free ports)"
+    fi
+  done
+fi
 
 if [[ -n $resume ]]; then
   run_dir=$resume
+  # A run started with --curve goes on with CURVE (its config says cluster.curve = true).
+  [[ -f $run_dir/keys/client.keys ]] && curve=1
   [[ -f $run_dir/checkpoint.ckpt ]] || die "--resume $run_dir: no checkpoint.ckpt there"
   learner_args=(--resume "$run_dir")
 else
@@ -75,7 +83,24 @@ else
   learner_args=(--config "$config" --run-dir "$run_dir")
 fi
 mkdir -p "$run_dir/logs"
-join="tcp://127.0.0.1:$port"
+if ((port > 0)); then
+  join="tcp://127.0.0.1:$port"
+  weights="tcp://127.0.0.1:$((port + 1))"
+else
+  join="tcp://127.0.0.1:0"
+  weights="tcp://127.0.0.1:0"
+fi
+learner_curve=()
+peer_curve=()
+if ((curve)); then
+  # Fresh keys for a new run; a resumed run keeps its own (its actors and shards may still hold them).
+  keys=$run_dir/keys
+  if [[ ! -f $keys/client.keys ]]; then
+    "$bin" keygen --dir "$keys" >/dev/null || die "pamdp keygen --dir $keys failed"
+  fi
+  learner_curve=(--set cluster.curve=true --set "cluster.curve_keys_dir=$keys")
+  peer_curve=(--curve-keys "$keys")
+fi
 
 pids=()
 stop_all() {
@@ -94,26 +119,37 @@ stop_all() {
 trap stop_all INT TERM EXIT
 
 "$bin" learner "${learner_args[@]}" \
-  --set "cluster.learner_bind=$join" --set "cluster.weights_bind=tcp://127.0.0.1:$((port + 1))" \
-  --set "replay.shards=$shards" "${sets[@]}" >"$run_dir/logs/learner.log" 2>&1 &
+  --set "cluster.learner_bind=$join" --set "cluster.weights_bind=$weights" \
+  --set "replay.shards=$shards" "${learner_curve[@]}" "${sets[@]}" >"$run_dir/logs/learner.log" 2>&1 &
 pids+=($!)
+if ((port == 0)); then
+  # The ports the OS chose, from the learner's first lines.
+  for _ in $(seq 300); do
+    join=$(grep -o "join: *tcp://127\.0\.0\.1:[0-9]*" "$run_dir/logs/learner.log" | head -n 1 | grep -o 'tcp://.*' || true)
+    weights=$(grep -o "weights: *tcp://127\.0\.0\.1:[0-9]*" "$run_dir/logs/learner.log" | head -n 1 | grep -o 'tcp://.*' || true)
+    [[ -n $join ]] && break
+    kill -0 "${pids[0]}" 2>/dev/null || break
+    sleep 0.1
+  done
+  [[ -n $join ]] || die "the learner did not report its join endpoint; see $run_dir/logs/learner.log"
+fi
 for ((i = 0; i < shards; i++)); do
   "$bin" replay --join "$join" --insert-bind "tcp://127.0.0.1:0" --sample-bind "tcp://127.0.0.1:0" \
-    --snapshot "$run_dir/shard-$i.replay" >"$run_dir/logs/shard-$i.log" 2>&1 &
+    --snapshot "$run_dir/shard-$i.replay" "${peer_curve[@]}" >"$run_dir/logs/shard-$i.log" 2>&1 &
   pids+=($!)
 done
 for ((i = 0; i < actors; i++)); do
-  "$bin" actor --join "$join" --seed $((1000 + i)) >"$run_dir/logs/actor-$i.log" 2>&1 &
+  "$bin" actor --join "$join" --seed $((1000 + i)) "${peer_curve[@]}" >"$run_dir/logs/actor-$i.log" 2>&1 &
   pids+=($!)
 done
 
 cat <<EOF
-local-cluster: learner + $shards shards + $actors actors on this machine
+local-cluster: learner + $shards shards + $actors actors on this machine$( ((curve)) && echo ", CURVE on every socket")
   run directory: $run_dir   (config.toml, metrics.csv, episodes.csv, checkpoint.ckpt)
   logs:          $run_dir/logs/{learner,shard-*,actor-*}.log
-  learner:       $join (weights on tcp://127.0.0.1:$((port + 1)))
-  add an actor:  $bin actor --join $join
-  watch it:      $bin monitor --join $join   (metrics URLs: $run_dir/metrics_urls.txt)
+  learner:       $join (weights on $weights)
+  add an actor:  $bin actor --join $join ${peer_curve[*]}
+  watch it:      $bin monitor --join $join ${peer_curve[*]}   (metrics URLs: $run_dir/metrics_urls.txt)
 Ctrl-C stops everything and leaves the run resumable.
 EOF
 

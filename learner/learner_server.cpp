@@ -41,6 +41,7 @@ LearnerServer::LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerS
       config_(std::move(config)),
       join_(ctx, net::SocketType::kRouter),
       weights_(ctx, net::SocketType::kPub),
+      handshakes_(ctx, {&join_, &weights_}, "learner"),
       fbb_(std::make_unique<FbbHolder>()) {
   // A join socket peer can send at most a JoinRequest, heartbeats and episode reports: small.
   join_.set_max_message_bytes(1 << 20);
@@ -361,6 +362,7 @@ void LearnerServer::run() {
     if (ms_since(last_tick) >= 1000) {
       last_tick = Clock::now();
       refresh_peers(true);
+      counters_.connections_refused = handshakes_.refused();
       if (waiting) {
         counters_.waiting_for_data_ms += ms_since(waiting_since);
         waiting_since = Clock::now();
@@ -370,6 +372,7 @@ void LearnerServer::run() {
       }
     }
   }
+  counters_.connections_refused = handshakes_.refused();
   publish_weights();
 }
 

@@ -29,8 +29,8 @@ namespace pamdp {
 struct FbbHolder;
 
 struct LearnerServerConfig {
-  std::string join_bind = "tcp://*:5555";
-  std::string weights_bind = "tcp://*:5556";
+  std::string join_bind = "tcp://127.0.0.1:5555";  // loopback by default (docs/protocol.md, "Security")
+  std::string weights_bind = "tcp://127.0.0.1:5556";
   std::string advertise_host = "127.0.0.1";
   std::string config_toml;  // handed to every peer in the cluster map
   int64_t publish_every_updates = 100;
@@ -55,6 +55,7 @@ struct LearnerCounters {
   int64_t actors_joined = 0;
   int64_t actors_alive = 0;  // actors heard from within peer_timeout_ms
   int64_t waiting_for_data_ms = 0;
+  int64_t connections_refused = 0;  // failed handshakes at the join and weights sockets (no or wrong CURVE key)
 };
 
 struct EpisodeSummary {
@@ -90,6 +91,9 @@ class LearnerServer {
   void run();
   void stop() { stop_.store(true); }
   [[nodiscard]] const LearnerCounters& counters() const { return counters_; }
+  // Handshakes refused at the join and weights sockets so far; any thread (counters() copies it
+  // once a second).
+  [[nodiscard]] int64_t connections_refused() const { return handshakes_.refused(); }
   // The learner's own metrics URL first, then the live peers' (shards, then actors), as served
   // to `pamdp monitor` (MetricsUrlsRequest). Learner thread only.
   [[nodiscard]] const std::vector<std::string>& metrics_urls() const { return metrics_urls_; }
@@ -119,6 +123,7 @@ class LearnerServer {
   LearnerServerConfig config_;
   net::Socket join_;
   net::Socket weights_;
+  net::HandshakeMonitor handshakes_;  // after the sockets: stops watching before they close
   std::string join_endpoint_;
   std::string weights_endpoint_;
   std::vector<std::unique_ptr<Shard>> shards_;

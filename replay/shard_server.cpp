@@ -148,7 +148,8 @@ ShardServer::ShardServer(net::Context& ctx, ShardServerOptions options, ShardCon
       config_from_map_(std::move(config_from_map)),
       insert_(ctx, net::SocketType::kRouter),
       sample_(ctx, net::SocketType::kRouter),
-      join_(ctx, net::SocketType::kDealer) {
+      join_(ctx, net::SocketType::kDealer),
+      handshakes_(ctx, {&insert_, &sample_}, "replay shard '" + options_.name + "'") {
   if (!config_from_map_) {
     misuse("ShardServer needs a config_from_map function");
   }
@@ -210,6 +211,7 @@ ShardCounters ShardServer::counters() const {
   c.capacity = capacity_.load(r);
   c.inserts_held = inserts_held_pub_.load(r);
   c.restored = restored_.load(r);
+  c.connections_refused = handshakes_.refused();
   return c;
 }
 

@@ -102,9 +102,9 @@ class ReplayShard {
 };
 
 struct ShardServerOptions {
-  std::string join_endpoint;  // the learner's join ROUTER, e.g. tcp://learner:5555 (required)
-  std::string insert_bind = "tcp://*:0";
-  std::string sample_bind = "tcp://*:0";
+  std::string join_endpoint;                      // the learner's join ROUTER, e.g. tcp://learner:5555 (required)
+  std::string insert_bind = "tcp://127.0.0.1:0";  // loopback by default (docs/protocol.md, "Security")
+  std::string sample_bind = "tcp://127.0.0.1:0";
   std::string advertise_host = "127.0.0.1";  // replaces * / 0.0.0.0 in the advertised endpoints
   std::string name = "replay";               // for the learner's logs
   std::string snapshot_path;                 // empty: no snapshot
@@ -144,6 +144,7 @@ struct ShardCounters {
   int64_t map_version = 0;          // of the last ClusterMap; 0 before joining
   int64_t joins = 0;                // ClusterMaps taken (1 + re-joins)
   int64_t restored = 0;             // transitions restored from the snapshot at start
+  int64_t connections_refused = 0;  // failed handshakes at the insert and sample sockets (no or wrong CURVE key)
 };
 
 // Builds the shard settings from a ClusterMap's config_toml; throws std::runtime_error if the
@@ -206,6 +207,7 @@ class ShardServer {
   net::Socket insert_;
   net::Socket sample_;
   net::Socket join_;
+  net::HandshakeMonitor handshakes_;  // after the sockets: stops watching before they close
   std::string insert_endpoint_;
   std::string sample_endpoint_;
   // One poller per set of sockets worth reading: join always, insert only while the limiter

@@ -3,8 +3,9 @@
 # 2 actors as real processes on the toy ReachStop task. Asserts that transitions flow, samples
 # are served, updates happen, weights reach the actors, episode reports are counted, and that
 # the checkpoint the learner wrote can be evaluated.
-# With a third argument "curve", every socket uses CURVE (pamdp keygen), and an actor with keys
-# of another keygen run must be refused by the learner without disturbing the cluster.
+# With a third argument "curve", every socket uses CURVE (pamdp keygen), and four intruders (an
+# actor with another keygen run's client key, a keyless actor, a shard with a foreign keyring, a
+# keyless shard) must be refused by the learner, counted on its /metrics, and not join.
 # With "netns", the same with CURVE across two network namespaces made for the test (learner and
 # shards in one, actors in the other, joined by a veth pair); it needs root and `ip netns` and
 # exits 77 (ctest: skipped) with a message where that is not permitted.
@@ -16,6 +17,7 @@ mode=${3:-plain}
 work=$(mktemp -d /tmp/pamdp-cluster-test.XXXXXX)
 pids=()
 host=127.0.0.1
+act_host=127.0.0.1
 srv=()  # command prefix of the learner's side
 act=()  # command prefix of the actors' side
 ns_srv="pamdp-srv-$$"
@@ -55,6 +57,7 @@ if [[ $mode == netns ]]; then
   ip -n "$ns_srv" link set "veth-s$$" up
   ip -n "$ns_act" link set "veth-a$$" up
   host=10.77.0.1
+  act_host=10.77.0.2
   srv=(ip netns exec "$ns_srv")
   act=(ip netns exec "$ns_act")
 fi
@@ -103,9 +106,31 @@ for i in 0 1; do
   pids+=($!)
 done
 if [[ $mode == curve || $mode == netns ]]; then
-  # An intruder with another keygen run's keys: refused at the handshake, never joins.
+  # The refusal table (docs/reliability.md), from the actors' host: an actor with another keygen
+  # run's client key (knowing the server's public key), an actor without keys, a shard with a whole
+  # foreign keyring and a shard without keys. Each is refused at the handshake and counted on the
+  # learner's /metrics; none joins (the actor and shard counts below stay 2).
+  "$bin" keygen --dir "$work/foreign-keys" >/dev/null
   "${act[@]}" "$bin" actor --join "$join" --curve-keys "$work/wrong-keys" >"$work/logs/intruder.log" 2>&1 &
   pids+=($!)
+  "${act[@]}" "$bin" actor --join "$join" --insecure --join-timeout 0 >"$work/logs/intruder-plain.log" 2>&1 &
+  pids+=($!)
+  "${act[@]}" "$bin" replay --join "$join" --insert-bind "tcp://$act_host:0" --sample-bind "tcp://$act_host:0" \
+    --advertise-host "$act_host" --curve-keys "$work/foreign-keys" >"$work/logs/intruder-shard.log" 2>&1 &
+  pids+=($!)
+  "${act[@]}" "$bin" replay --join "$join" --insert-bind "tcp://$act_host:0" --sample-bind "tcp://$act_host:0" \
+    --advertise-host "$act_host" --insecure >"$work/logs/intruder-shard-plain.log" 2>&1 &
+  pids+=($!)
+  lurl=$(grep -o 'http://127\.0\.0\.1:[0-9]*/metrics' "$work/logs/learner.log" | head -n 1 || true)
+  refused=""
+  for _ in $(seq 100); do
+    refused=$("${srv[@]}" curl -sf --max-time 2 "$lurl" | awk '$1 == "pamdp_connections_refused_total" { print $2 }' || true)
+    [[ $refused =~ ^[0-9]+$ ]] && ((refused >= 4)) && break
+    sleep 0.1
+  done
+  [[ $refused =~ ^[0-9]+$ ]] && ((refused >= 4)) ||
+    fail "the learner's /metrics counted '$refused' refused connections of 4 intruders"
+  echo "CURVE: 4 intruders (foreign key, no key, foreign keyring shard, keyless shard): $refused refusals counted"
 fi
 
 # The learner stops by itself at train.max_updates; give it at most 90 s.

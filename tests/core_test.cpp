@@ -427,3 +427,23 @@ TEST(CurveKeys, WrittenPrivateRefusedWhenWorldReadable) {
 }
 
 }  // namespace
+
+namespace {
+
+// Which binds and joins stay on this machine (issue 33: anything else needs CURVE or insecure).
+TEST(Transport, LoopbackEndpoints) {
+  using pamdp::net::is_loopback_endpoint;
+  for (const char* local :
+       {"tcp://127.0.0.1:5555", "tcp://127.0.0.1:0", "tcp://127.0.0.1:*", "tcp://127.1.2.3:9", "tcp://localhost:5555",
+        "tcp://[::1]:5555", "tcp://lo:5555", "inproc://x", "ipc:///tmp/s"}) {
+    EXPECT_TRUE(is_loopback_endpoint(local)) << local;
+  }
+  for (const char* exposed :
+       {"tcp://*:5555", "tcp://0.0.0.0:5555", "tcp://[::]:5555", "tcp://10.0.0.5:5555", "tcp://eth0:5555",
+        "tcp://learner:5555", "tcp://128.0.0.1:1", "tcp://127.0.0.1.evil:1", "tcp://127.0.0.1;10.0.0.5:1",
+        "tcp://127.0.0.256:1", "udp://127.0.0.1:1", "tcp://127.0.0.1", ""}) {
+    EXPECT_FALSE(is_loopback_endpoint(exposed)) << exposed;
+  }
+}
+
+}  // namespace

@@ -6,11 +6,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/rng.hpp"
 #include "core/transport.hpp"
 #include "core/wire.hpp"
 #include "envs/toy/reach_stop.hpp"
@@ -181,6 +183,47 @@ const wire::Envelope* await_payload(net::Socket& s, net::Message& m, wire::Paylo
   return nullptr;
 }
 
+// The probe of issue 33 at the learner's join socket, bounded and on loopback: 2,000 random
+// frames (empty, 1-7 bytes, short ones with the schema's identifier, up to 4 KB) from one DEALER,
+// then a MetricsUrlsRequest; the join socket reads one peer's frames in order, so once its answer
+// comes every frame before it has been handled, and each must have been counted.
+TEST(LearnerServer, EveryRandomFrameAtTheJoinSocketIsCounted) {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
+  LearnerServer server(ctx, backend, loopback_config());
+  std::thread thread([&] { server.run(); });
+  net::Socket probe(ctx, net::SocketType::kDealer);
+  probe.connect(server.join_endpoint());
+  Rng rng(33);
+  constexpr int kFrames = 2000;
+  std::vector<uint8_t> frame;
+  for (int i = 0; i < kFrames; ++i) {
+    const int kind = i % 10;
+    const size_t size = kind == 0   ? 0
+                        : kind == 1 ? 1 + rng.next_u64() % 7
+                        : kind <= 4 ? 8 + rng.next_u64() % 57
+                                    : rng.next_u64() % 4097;
+    frame.resize(size);
+    for (uint8_t& b : frame) {
+      b = static_cast<uint8_t>(rng.next_u64());
+    }
+    if (kind >= 2 && kind <= 4) {
+      std::memcpy(frame.data() + 4, "PMSG", 4);  // the envelope's file identifier
+    }
+    ASSERT_TRUE(probe.send(frame, 2000)) << "frame " << i;
+  }
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_metrics_urls_request(fbb);
+  ASSERT_TRUE(probe.send(wire::bytes_of(fbb), 2000));
+  net::Message m;
+  EXPECT_NE(await_payload(probe, m, wire::Payload::MetricsUrls), nullptr);
+  server.stop();
+  thread.join();
+  EXPECT_EQ(server.counters().malformed_messages, kFrames);
+}
+
 TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   net::Context ctx;
   toy::ReachStopEnv env;
@@ -281,6 +324,47 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   wire::build_join_request(fbb, wire::Role::Actor, "intruder", "", "", 1);
   (void)bad_join.send(wire::bytes_of(fbb), 200);  // queued until a handshake that never succeeds
 
+  // The refusal table (docs/reliability.md), one intruder at a time so that each is seen counted:
+  // no key at all (a plain SUB, a plain actor, a plain shard), a key the cluster did not issue, and
+  // the cluster's own client key with another server public key.
+  auto refused_more_than = [&](int64_t before) {
+    const auto until = Clock::now() + std::chrono::seconds(5);
+    while (server.connections_refused() <= before && Clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return server.connections_refused() > before;
+  };
+  ASSERT_TRUE(refused_more_than(1)) << "the two foreign-key intruders: " << server.connections_refused();
+  net::Socket plain_sub(ctx, net::SocketType::kSub);
+  int64_t before = server.connections_refused();
+  plain_sub.subscribe_all();
+  plain_sub.connect(server.weights_endpoint());
+  EXPECT_TRUE(refused_more_than(before)) << "a plain SUB on the weights socket was not counted";
+  std::vector<net::Socket> intruders;
+  const std::string nowhere = "tcp://127.0.0.1:1";
+  const net::CurveServerKeys other_server = net::generate_curve_keypair();
+  const net::CurveClientKeys wrong_server{cluster_client.public_key, cluster_client.secret_key,
+                                          other_server.public_key};
+  for (int kind = 0; kind < 4; ++kind) {
+    before = server.connections_refused();
+    intruders.emplace_back(ctx, net::SocketType::kDealer);
+    net::Socket& s = intruders.back();
+    if (kind == 2) {
+      s.make_curve_client(bad);
+    } else if (kind == 3) {
+      s.make_curve_client(wrong_server);
+    }
+    s.connect(server.join_endpoint());
+    if (kind == 0) {
+      wire::build_join_request(fbb, wire::Role::Actor, "plain-actor", "", "", 1);
+    } else {
+      wire::build_join_request(fbb, wire::Role::Shard, "intruding-shard", nowhere, nowhere, 0);
+    }
+    (void)s.send(wire::bytes_of(fbb), 200);
+    EXPECT_TRUE(refused_more_than(before)) << "intruder " << kind << " (0 plain actor, 1 plain shard, 2 foreign "
+                                           << "key shard, 3 wrong server key shard) was not counted";
+  }
+
   // A shard with the cluster's key: its sample socket is a CURVE server with the cluster's keys.
   net::Socket sample(ctx, net::SocketType::kRouter);
   sample.make_curve_server(server_keys);
@@ -291,7 +375,10 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
   ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
   net::Message m;
-  ASSERT_NE(await_payload(join, m, wire::Payload::ClusterMap), nullptr);
+  const wire::Envelope* map_env = await_payload(join, m, wire::Payload::ClusterMap);
+  ASSERT_NE(map_env, nullptr);
+  EXPECT_EQ(map_env->payload_as_ClusterMap()->shard_sample_endpoints()->size(), 1U)
+      << "an intruding shard is in the map";
 
   // Serve samples until the run ends; the good subscriber counts what it receives meanwhile.
   std::vector<float> states(kBatch * kObs, 0.1F);
@@ -323,7 +410,14 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   EXPECT_GT(received, 10) << "the subscriber with the cluster's key got " << received << " publications";
   EXPECT_FALSE(bad_sub.recv(m, 300)) << "a subscriber with a foreign key received weights";
   EXPECT_FALSE(bad_join.recv(m, 300)) << "a joiner with a foreign key was answered";
-  EXPECT_GE(auth.refused(), 2);
+  EXPECT_FALSE(plain_sub.recv(m, 100)) << "a plain subscriber received weights";
+  for (net::Socket& s : intruders) {
+    EXPECT_FALSE(s.recv(m, 100)) << "an intruding joiner was answered";
+  }
+  EXPECT_GE(auth.refused(), 3);  // the ZAP handler sees only the foreign client keys
+  EXPECT_GE(server.connections_refused(), 7);
+  EXPECT_GE(server.counters().connections_refused, 7);  // as the metrics see it
+  EXPECT_EQ(server.counters().shards, 1);
   EXPECT_EQ(server.counters().actors_alive, 0);
   EXPECT_EQ(server.counters().malformed_messages, 0);
 }

@@ -13,15 +13,12 @@ using agent2d::angle_norm;
 using agent2d::Command;
 using agent2d::GoalieWorld;
 using agent2d::InterceptTable;
+using agent2d::kOurPenaltyLineX;
+using agent2d::th_deg;
 
 // ServerParam values agent2d reads (librcsc common/server_param.cpp defaults).
-constexpr double kOurPenaltyLineX = -kPitchHalfLength + 16.5;  // ourPenaltyAreaLineX(): -36
-constexpr double kPenaltyHalfWidth = kPenaltyBoxHalfWidth;     // penaltyAreaHalfWidth(): 20.16
-constexpr double kErrorValue = DBL_MAX;                        // Vector2D::ERROR_VALUE
-
-double th_deg(Vec2 v) {
-  return std::atan2(v.y, v.x) * kRadToDeg;
-}
+constexpr double kPenaltyHalfWidth = kPenaltyBoxHalfWidth;  // penaltyAreaHalfWidth(): 20.16
+constexpr double kErrorValue = DBL_MAX;                     // Vector2D::ERROR_VALUE
 
 // librcsc Line2D: a x + b y + c = 0.
 struct Line {

@@ -11,9 +11,6 @@
 namespace pamdp::hfo::agent2d {
 namespace {
 
-// Player type 0's real speed max (PlayerType::realSpeedMax: max dash accel over 1 - decay,
-// capped at player_speed_max): 100 x 0.006 / 0.6 = 1.0.
-constexpr double kRealSpeedMax = std::min(kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay), kPlayerSpeedMax);
 // ServerParam::recoverDecThrValue(): recover_dec_thr x stamina_max.
 constexpr double kRecoverDecThrValue = kRecoverDecThreshold;
 // Body_GoToPoint2010: the distance within which a sideways dash is tried (adjustable_dist).
@@ -22,23 +19,8 @@ constexpr double kIllegalPower = -65535.0;
 constexpr double kMaxNeckAngle = 90.0;  // ServerParam::DEFAULT_MAX_NECK_ANGLE
 constexpr double kMinNeckAngle = -90.0;
 
-double th_deg(Vec2 v) {
-  return std::atan2(v.y, v.x) * kRadToDeg;
-}
-
-Vec2 rotate(Vec2 v, double deg) {
-  const double c = std::cos(deg * kDegToRad);
-  const double s = std::sin(deg * kDegToRad);
-  return {v.x * c - v.y * s, v.x * s + v.y * c};
-}
-
 double dash_rate(const GoalieWorld& w) {
   return w.self.effort * kDashPowerRate;  // SelfObject::dashRate()
-}
-
-// calc_first_term_geom_series (librcsc math_util.h).
-double first_term_geom_series(double sum, double r, int len) {
-  return sum * (1.0 - r) / (1.0 - std::pow(r, len));
 }
 
 // Number of points where the segment a-b meets the circle (Circle2D::intersection with a
@@ -150,7 +132,7 @@ bool adjust_dash(const GoalieWorld& w, Vec2 target, double dist_thr, double max_
   if (target_rel.r2() > (dist_thr + kAdjustableDist) * (dist_thr + kAdjustableDist)) {
     return false;
   }
-  target_rel = rotate(target_rel, -w.self.body_deg);
+  target_rel = rotate_deg(target_rel, -w.self.body_deg);
   if (std::fabs(target_rel.y) < dist_thr) {
     return false;
   }
@@ -158,7 +140,7 @@ bool adjust_dash(const GoalieWorld& w, Vec2 target, double dist_thr, double max_
   if (std::fabs(target_angle) < dir_thr) {
     return false;
   }
-  const Vec2 rel_vel = rotate(w.self.vel, -w.self.body_deg);
+  const Vec2 rel_vel = rotate_deg(w.self.vel, -w.self.body_deg);
   // dash_angle_step 45, dash angles [-180, 180]: the loop runs over -180 .. 135.
   const double step = std::max(15.0, kDashAngleStep);
   const double min_dir = step * static_cast<int>(-180.0 / step);
@@ -185,7 +167,7 @@ bool adjust_dash(const GoalieWorld& w, Vec2 target, double dist_thr, double max_
     Vec2 my_pos = rel_vel * ((1.0 - player_decay_pow(cycle_n)) / (1.0 - kPlayerDecay));
     int c = 0;
     for (; c < max_cycle; ++c) {
-      const Vec2 required_move = rotate(target_rel - my_pos, -dash_angle);
+      const Vec2 required_move = rotate_deg(target_rel - my_pos, -dash_angle);
       const double required_x_accel = first_term_geom_series(required_move.x, kPlayerDecay, cycle_n - c);
       if (required_x_accel < 0.01) {
         break;
@@ -276,13 +258,13 @@ bool body_go_to_point(const GoalieWorld& w, Vec2 point, double dist_thr, double 
   }
   // doDash.
   const double accel_angle = w.self.body_deg + (back_mode ? 180.0 : 0.0);
-  const Vec2 rel = rotate(target_rel, -accel_angle);
+  const Vec2 rel = rotate_deg(target_rel, -accel_angle);
   double first_speed = first_term_geom_series(rel.x, kPlayerDecay, cycle_n);
   first_speed = clamp(first_speed, -kPlayerSpeedMax, kPlayerSpeedMax);
   if (dash_speed > 0.0) {
     first_speed = first_speed > 0.0 ? std::min(first_speed, dash_speed) : std::max(first_speed, -dash_speed);
   }
-  const Vec2 rel_vel = rotate(w.self.vel, -accel_angle);
+  const Vec2 rel_vel = rotate_deg(w.self.vel, -accel_angle);
   const double required_accel = first_speed - rel_vel.x;
   if (std::fabs(required_accel) >= 0.05) {
     double dash_power = std::min(required_accel / dash_rate(w), max_dash_power);
@@ -321,7 +303,7 @@ bool body_stop_dash(const GoalieWorld& w, bool save_recovery, Command* out) {
   for (double dir = min_dir; dir < max_dir; dir += step) {
     const double rate = dash_rate(w) * dash_dir_rate(dir);
     const double dash_angle = w.self.body_deg + discretize_dash_dir(clamp(dir, kMinMoment, kMaxMoment));
-    const Vec2 rel_vel = rotate(w.self.vel, -dash_angle);
+    const Vec2 rel_vel = rotate_deg(w.self.vel, -dash_angle);
     double power = clamp(-rel_vel.x / rate, kMinDashPower, kMaxDashPower);
     if (save_recovery) {
       power = safety_dash_power(w, power);

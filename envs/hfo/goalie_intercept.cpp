@@ -1,6 +1,7 @@
 // librcsc's intercept table for the goalie (rcsc/player/intercept_table.cpp, player_intercept.cpp).
-// The goalie's own intercept is goalie_self_intercept.cpp. PROVISIONAL: Body_Intercept2009 below
-// is an estimate until its port lands.
+// The ball's path and the attacker's reach (InterceptTable::createBallCache, PlayerIntercept)
+// and the goalie's intercept action (Body_Intercept2009); its own ways to the ball are in
+// goalie_self_intercept.cpp. Our own code; rules and constants librcsc's, cited where used.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,9 +11,6 @@
 
 namespace pamdp::hfo::agent2d {
 namespace {
-
-// PlayerType's real speed max for type 0: min(100 x 0.006 x 1 / (1 - 0.4), 1.05) = 1.0.
-constexpr double kRealSpeedMax = std::min(kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay), kPlayerSpeedMax);
 
 // PlayerType's dash distance table (common/player_type.cpp, PlayerType::initAdditionalParams):
 // distance covered by n full dashes from rest, n = 1..50 (type 0 never reaches the speed cap
@@ -52,10 +50,6 @@ namespace {
 
 Vec2 inertia_point(Vec2 pos, Vec2 vel, int n) {
   return pos + vel * ((1.0 - player_decay_pow(n)) / (1.0 - kPlayerDecay));
-}
-
-double th_deg(Vec2 v) {
-  return std::atan2(v.y, v.x) * kRadToDeg;
 }
 
 // PlayerIntercept::predictTurnCycle: one turn at most.
@@ -106,11 +100,7 @@ int predict_final(const GoalieWorld& w, const InterceptTable& t, const PlayerVie
 // PlayerIntercept::predict for an opponent with full state.
 int predict_opponent(const GoalieWorld& w, const InterceptTable& t, const PlayerView& p) {
   Vec2 ball_to_player = p.pos - w.ball_pos;
-  {
-    const double a = -th_deg(w.ball_vel) * kDegToRad;
-    ball_to_player = {ball_to_player.x * std::cos(a) - ball_to_player.y * std::sin(a),
-                      ball_to_player.x * std::sin(a) + ball_to_player.y * std::cos(a)};
-  }
+  { ball_to_player = rotate_deg(ball_to_player, -th_deg(w.ball_vel)); }
   int min_cycle = static_cast<int>(std::floor(std::fabs(ball_to_player.y) / kRealSpeedMax));
   if (p.tackling) {
     min_cycle += std::max(0, kTackleCycles - 2);
@@ -190,7 +180,7 @@ const InterceptInfo* best_intercept(const GoalieWorld& w, const InterceptTable& 
   const Vec2 our_goal_pos{-kPitchHalfLength, 0.0};
   const double max_pitch_x = kPitchHalfLength - 1.0;
   const double max_pitch_y = kPitchHalfWidth - 1.0;
-  const double penalty_x = -kPitchHalfLength + 16.5;
+  const double penalty_x = kOurPenaltyLineX;
   const double penalty_y = kPenaltyBoxHalfWidth;
   const double speed_max = kRealSpeedMax * 0.9;
   const int opp_min = t.opponent_reach_cycle;
@@ -352,12 +342,6 @@ const InterceptInfo* best_intercept(const GoalieWorld& w, const InterceptTable& 
   return &cache[0];
 }
 
-Vec2 rotate_deg(Vec2 v, double deg) {
-  const double c = std::cos(deg * kDegToRad);
-  const double s = std::sin(deg * kDegToRad);
-  return {v.x * c - v.y * s, v.x * s + v.y * c};
-}
-
 // Body_Intercept2009::doWaitTurn. The default face point (M_face_point invalid) is (50.5, y x 0.9).
 bool wait_turn(const GoalieWorld& w, const InterceptTable& t, Vec2 target_point, const InterceptInfo& info,
                Command* out) {
@@ -425,7 +409,7 @@ bool inertia_dash(const GoalieWorld& w, Vec2 target_point, const InterceptInfo& 
   if (w.ball_vel.r() * ball_decay_pow(info.reach_cycle()) < kKickableArea * 1.5 &&
       std::fabs(info.dash_angle_deg) < 5.0 &&
       std::fabs(target_rel.x) < kKickableArea + dash_rate * kMaxDashPower * 0.8) {
-    double first_speed = target_rel.x * (1.0 - kPlayerDecay) / (1.0 - player_decay_pow(info.reach_cycle()));
+    double first_speed = first_term_geom_series(target_rel.x, kPlayerDecay, info.reach_cycle());
     first_speed = clamp(first_speed, -kPlayerSpeedMax, kPlayerSpeedMax);
     const Vec2 rel_vel = rotate_deg(w.self.vel, -w.self.body_deg);
     const double required_accel = first_speed - rel_vel.x;

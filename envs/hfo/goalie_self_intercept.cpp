@@ -13,27 +13,14 @@
 namespace pamdp::hfo::agent2d {
 namespace {
 
-constexpr int kMaxShortStep = 5;             // SelfInterceptV13::MAX_SHORT_STEP
-constexpr double kMinTurnThr = 12.5;         // MIN_TURN_THR
-constexpr double kBackDashThrAngle = 100.0;  // BACK_DASH_THR_ANGLE
-constexpr double kControlAreaBuf = 0.15;     // control_area_buf (2009-07-03)
-constexpr double kRealSpeedMax = std::min(kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay), kPlayerSpeedMax);
-constexpr double kOurPenaltyLineX = -kPitchHalfLength + 16.5;
+constexpr int kMaxShortStep = 5;                              // SelfInterceptV13::MAX_SHORT_STEP
+constexpr double kMinTurnThr = 12.5;                          // MIN_TURN_THR
+constexpr double kBackDashThrAngle = 100.0;                   // BACK_DASH_THR_ANGLE
+constexpr double kControlAreaBuf = 0.15;                      // control_area_buf (2009-07-03)
 constexpr double kRecoverDecThrValue = kRecoverDecThreshold;  // recover_dec_thr x stamina_max
 
-double th_deg(Vec2 v) {
-  return std::atan2(v.y, v.x) * kRadToDeg;
-}
-Vec2 rotate(Vec2 v, double deg) {
-  const double c = std::cos(deg * kDegToRad);
-  const double s = std::sin(deg * kDegToRad);
-  return {v.x * c - v.y * s, v.x * s + v.y * c};
-}
 Vec2 from_polar(double r, double deg) {
   return polar(r, deg * kDegToRad);
-}
-double first_term_geom_series(double sum, double r, int len) {
-  return sum * (1.0 - r) / (1.0 - std::pow(r, len));
 }
 Vec2 inertia_point(Vec2 pos, Vec2 vel, int n) {
   return pos + vel * ((1.0 - player_decay_pow(n)) / (1.0 - kPlayerDecay));
@@ -41,7 +28,7 @@ Vec2 inertia_point(Vec2 pos, Vec2 vel, int n) {
 // PlayerType::normalizeAccel(velocity, accel vector).
 void normalize_accel(Vec2 vel, Vec2* accel) {
   if ((vel + *accel).r2() > kPlayerSpeedMax * kPlayerSpeedMax + 0.0001) {
-    const Vec2 rel_vel = rotate(vel, -th_deg(*accel));
+    const Vec2 rel_vel = rotate_deg(vel, -th_deg(*accel));
     const double max_dash_x = std::sqrt(kPlayerSpeedMax * kPlayerSpeedMax - rel_vel.y * rel_vel.y);
     const double len = max_dash_x - rel_vel.x;
     const double r = accel->r();
@@ -155,7 +142,7 @@ class SelfIntercept {
     const Vec2 ball_next = w_.ball_pos + w_.ball_vel;
     const bool goalie_mode = ball_next.x < kOurPenaltyLineX && std::fabs(ball_next.y) < kPenaltyBoxHalfWidth;
     const double control = goalie_mode ? kCatchableArea : kKickableArea;
-    const Vec2 next_ball_rel = rotate(ball_next - my_next, -w_.self.body_deg);
+    const Vec2 next_ball_rel = rotate_deg(ball_next - my_next, -w_.self.body_deg);
     const double ball_noise = w_.ball_vel.r() * w_.ball_rand;
     const double next_ball_dist = next_ball_rel.r();
     if (next_ball_dist > control - 0.15 - ball_noise) {
@@ -237,9 +224,9 @@ class SelfIntercept {
     const double dash_dir = angle_norm(dash_angle - w_.self.body_deg);
     const Vec2 ball_next = w_.ball_pos + w_.ball_vel;
     const Vec2 self_next = w_.self.pos + w_.self.vel;
-    const Vec2 ball_rel = rotate(ball_next - self_next, -dash_angle);
-    const Vec2 forward_rel = rotate(max_forward_accel, -dash_angle);
-    const Vec2 back_rel = rotate(max_back_accel, -dash_angle);
+    const Vec2 ball_rel = rotate_deg(ball_next - self_next, -dash_angle);
+    const Vec2 forward_rel = rotate_deg(max_forward_accel, -dash_angle);
+    const Vec2 back_rel = rotate_deg(max_back_accel, -dash_angle);
     const double rate = dash_rate() * dash_dir_rate(dash_dir);
     if (std::fabs(ball_rel.y) > control_buf || segment_dist(forward_rel, back_rel, ball_rel) > control_buf) {
       return false;
@@ -306,7 +293,7 @@ class SelfIntercept {
     const int max_loop = std::min(kMaxShortStep, max_cycle);
     const double pen_area_x = kOurPenaltyLineX - 0.5;
     const double pen_area_y = kPenaltyBoxHalfWidth - 0.5;
-    const Vec2 ball_to_self = rotate(w_.self.pos - w_.ball_pos, -th_deg(w_.ball_vel));
+    const Vec2 ball_to_self = rotate_deg(w_.self.pos - w_.ball_pos, -th_deg(w_.ball_vel));
     int min_cycle = static_cast<int>(std::ceil((std::fabs(ball_to_self.y) - kKickableArea) / kRealSpeedMax));
     if (min_cycle >= max_loop) {
       return;
@@ -419,9 +406,9 @@ class SelfIntercept {
     const Vec2 accel_unit = from_polar(1.0, dash_angle);
     double first_dash_power = 0.0;
     for (int n_dash = 1; n_dash <= max_dash; ++n_dash) {
-      const Vec2 ball_rel = rotate(ball_pos - my_pos, -dash_angle);
+      const Vec2 ball_rel = rotate_deg(ball_pos - my_pos, -dash_angle);
       const double first_speed = first_term_geom_series(ball_rel.x, kPlayerDecay, max_dash - n_dash + 1);
-      const Vec2 rel_vel = rotate(my_vel, -dash_angle);
+      const Vec2 rel_vel = rotate_deg(my_vel, -dash_angle);
       const double required_accel = first_speed - rel_vel.x;
       double dash_power = required_accel / (kDashPowerRate * sm.effort);
       if (back_dash) {
@@ -483,7 +470,7 @@ class SelfIntercept {
       }
       {
         const Vec2 inertia = inertia_point(my_pos, my_vel, cycle - n_omni);
-        const Vec2 target_rel = rotate(ball_pos - inertia, -body_angle);
+        const Vec2 target_rel = rotate_deg(ball_pos - inertia, -body_angle);
         if ((back_dash && target_rel.x > 0.0) || (!back_dash && target_rel.x < 0.0)) {
           continue;
         }
@@ -491,8 +478,8 @@ class SelfIntercept {
       const Vec2 body_unit = from_polar(1.0, body_angle);
       for (int n_dash = n_omni + 1; n_dash <= cycle; ++n_dash) {
         const double first_speed =
-            first_term_geom_series(rotate(ball_pos - my_pos, -body_angle).x, kPlayerDecay, cycle - n_dash + 1);
-        const Vec2 rel_vel = rotate(my_vel, -body_angle);
+            first_term_geom_series(rotate_deg(ball_pos - my_pos, -body_angle).x, kPlayerDecay, cycle - n_dash + 1);
+        const Vec2 rel_vel = rotate_deg(my_vel, -body_angle);
         const double required_accel = first_speed - rel_vel.x;
         double dash_power = required_accel / (kDashPowerRate * sm.effort);
         if (back_dash) {
@@ -515,7 +502,7 @@ class SelfIntercept {
       }
       const Vec2 my_move = my_pos - w_.self.pos;
       if ((my_pos - ball_pos).r2() < std::pow(control - kControlAreaBuf, 2) ||
-          my_move.r() > std::fabs(rotate(ball_pos - w_.self.pos, -th_deg(my_move)).x)) {
+          my_move.r() > std::fabs(rotate_deg(ball_pos - w_.self.pos, -th_deg(my_move)).x)) {
         const InterceptInfo::Mode mode = sm.recovery < w_.self.recovery && !sm.capacity_is_empty()
                                              ? InterceptInfo::Mode::kExhaust
                                              : InterceptInfo::Mode::kNormal;
@@ -541,7 +528,7 @@ class SelfIntercept {
     for (int n = 1; n <= max_omni; ++n) {
       const double first_speed =
           first_term_geom_series(std::max(0.0, line_dist(ball_pos, body_angle, *my_pos)), kPlayerDecay, cycle - n + 1);
-      const Vec2 rel_vel = rotate(*my_vel, -dash_angle);
+      const Vec2 rel_vel = rotate_deg(*my_vel, -dash_angle);
       const double required_accel = first_speed - rel_vel.x;
       if (std::fabs(required_accel) < 0.01) {
         return n - 1;
@@ -574,7 +561,7 @@ class SelfIntercept {
 
   // ---- predictLongStep ----
   void predict_long_step(int max_cycle, bool save_recovery) {
-    const Vec2 ball_to_self = rotate(w_.self.pos - w_.ball_pos, -th_deg(w_.ball_vel));
+    const Vec2 ball_to_self = rotate_deg(w_.self.pos - w_.ball_pos, -th_deg(w_.ball_vel));
     int start_cycle = static_cast<int>(std::ceil((std::fabs(ball_to_self.y) - kKickableArea - 0.2) / kRealSpeedMax));
     if (start_cycle <= kMaxShortStep) {
       start_cycle = kMaxShortStep + 1;
@@ -696,12 +683,12 @@ class SelfIntercept {
     const double player_noise_rate = 1.0 - w_.player_rand * 0.01;
     const Vec2 my_inertia = self_inertia_point(w_, n_turn + n_dash);
     const double recover_dec_thr = kRecoverDecThreshold;
-    const Vec2 ball_rel = rotate(ball_pos - w_.self.pos, -dash_angle);
+    const Vec2 ball_rel = rotate_deg(ball_pos - w_.self.pos, -dash_angle);
     const double ball_noise = (w_.ball_pos - ball_pos).r() * w_.ball_rand * 0.5;
     const double noised_ball_x = ball_rel.x + ball_noise;
     // PlayerType::inertiaTravel of the velocity over the turns, in the dash frame.
-    Vec2 tmp_pos = rotate(w_.self.vel * ((1.0 - player_decay_pow(n_turn)) / (1.0 - kPlayerDecay)), -dash_angle);
-    Vec2 tmp_vel = rotate(w_.self.vel * player_decay_pow(n_turn), -dash_angle);
+    Vec2 tmp_pos = rotate_deg(w_.self.vel * ((1.0 - player_decay_pow(n_turn)) / (1.0 - kPlayerDecay)), -dash_angle);
+    Vec2 tmp_vel = rotate_deg(w_.self.vel * player_decay_pow(n_turn), -dash_angle);
     StaminaModel sm = stamina_of(w_.self);
     sm.waits(n_turn);
     const double prev_effort = sm.effort;
@@ -736,7 +723,7 @@ class SelfIntercept {
       tmp_vel *= kPlayerDecay;
       sm.dash(power_abs * (back_dash ? -1.0 : 1.0));
       if (tmp_pos.x * player_noise_rate + 0.1 > noised_ball_x) {
-        Vec2 my_final = w_.self.pos + rotate(tmp_pos, dash_angle);
+        Vec2 my_final = w_.self.pos + rotate_deg(tmp_pos, dash_angle);
         if ((my_inertia - my_final).r2() > 0.01) {
           my_final = line_projection(my_inertia, my_final, ball_pos);
         }
@@ -753,7 +740,7 @@ class SelfIntercept {
     const double last_ball_dist = (ball_rel - tmp_pos).r();
     const double buf = 0.2 + player_noise + ball_noise;
     if (last_ball_dist < std::max(control - 0.225, control - buf)) {
-      const Vec2 my_final = w_.self.pos + rotate(tmp_pos, dash_angle);
+      const Vec2 my_final = w_.self.pos + rotate_deg(tmp_pos, dash_angle);
       const InterceptInfo::Mode mode = sm.recovery < w_.self.recovery && !sm.capacity_is_empty()
                                            ? InterceptInfo::Mode::kExhaust
                                            : InterceptInfo::Mode::kNormal;

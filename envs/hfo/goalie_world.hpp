@@ -34,6 +34,27 @@ inline double angle_norm(double deg) {
   return deg;
 }
 
+// librcsc's small geometry, in degrees: Vector2D::th(), Vector2D::rotatedVector(),
+// calc_first_term_geom_series (math_util.h).
+inline double th_deg(Vec2 v) {
+  return std::atan2(v.y, v.x) * kRadToDeg;
+}
+inline Vec2 rotate_deg(Vec2 v, double deg) {
+  const double c = std::cos(deg * kDegToRad);
+  const double s = std::sin(deg * kDegToRad);
+  return {v.x * c - v.y * s, v.x * s + v.y * c};
+}
+inline double first_term_geom_series(double sum, double r, int len) {
+  return sum * (1.0 - r) / (1.0 - std::pow(r, len));
+}
+
+// PlayerType::realSpeedMax() of type 0: min(100 x 0.006 x 1 / (1 - 0.4), 1.05) = 1.0.
+inline constexpr double kRealSpeedMax = kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay) < kPlayerSpeedMax
+                                            ? kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay)
+                                            : kPlayerSpeedMax;
+// ServerParam::ourPenaltyAreaLineX(): the goal line plus penalty_area_length (16.5).
+inline constexpr double kOurPenaltyLineX = -kPitchHalfLength + 16.5;
+
 // ServerParam::catchableArea(): the diagonal of the catchable rectangle, sqrt(1.2^2 + 0.5^2).
 inline const double kCatchableArea =
     std::sqrt(kCatchableAreaLength * kCatchableAreaLength + 0.25 * kCatchableAreaWidth * kCatchableAreaWidth);
@@ -157,7 +178,7 @@ inline StaminaModel stamina_of(const SelfView& s) {
   return {s.stamina, s.effort, s.recovery, s.capacity};
 }
 
-// InterceptTable::update in two parts (goalie_intercept.cpp): the ball's path and the
+// InterceptTable::update in two parts (goalie_intercept.cpp, goalie_self_intercept.cpp): the ball's path and the
 // opponents' reach (PlayerIntercept), which every cycle needs, and the goalie's own ways to the
 // ball (SelfInterceptV13), which only some rules read, so the goalie computes them on demand.
 void predict_ball_and_opponents(const GoalieWorld& world, InterceptTable* table);

@@ -4,7 +4,8 @@
 #   bad flag, unknown config key (the valid keys listed), value out of range, unreachable join
 #   address (actor and shard, short --join-timeout), learner port in use, corrupt checkpoint
 #   (truncated; bytes flipped) for --resume and eval --checkpoint, a run directory of another
-#   experiment (--resume with other network widths).
+#   experiment (--resume with other network widths), a cluster socket beyond loopback without CURVE
+#   or insecure mode (and insecure mode's gauge and warning, in a network namespace of its own).
 # Usage: tests/system/operator_errors_test.sh PATH/TO/pamdp SOURCE_DIR
 set -euo pipefail
 bin=${1:?path to pamdp}
@@ -69,6 +70,56 @@ expect_error "actor: unreachable --join" 20 "tcp://127.0.0.1:1" "--join" -- \
   "$bin" actor --join tcp://127.0.0.1:1 --join-timeout 2
 expect_error "replay: unreachable --join" 20 "tcp://127.0.0.1:1" "--join" -- \
   "$bin" replay --join tcp://127.0.0.1:1 --join-timeout 2
+
+# --- secure by default (issue 33): no cluster socket beyond loopback without CURVE or insecure ---
+# Refused before anything binds or connects (0.0.0.0 as a join target would reach this machine only).
+expect_error "learner: wildcard bind without CURVE" 10 "cluster.learner_bind" "pamdp keygen" "cluster.curve=true" \
+  "cluster.insecure=true" -- "$bin" learner --config "$config" --run-dir "$work/exposed" \
+  --set cluster.learner_bind=tcp://0.0.0.0:0 --set cluster.weights_bind=tcp://127.0.0.1:0
+[[ ! -e $work/exposed ]] || { failures=$((failures + 1)); echo "FAIL  a refused learner created its run directory" >&2; }
+expect_error "learner: weights bind without CURVE" 10 "cluster.weights_bind" "pamdp keygen" -- \
+  "$bin" learner --config "$config" --run-dir "$work/exposed" --set cluster.learner_bind=tcp://127.0.0.1:0 \
+  --set "cluster.weights_bind=tcp://*:0"
+expect_error "learner: advertise host, loopback binds" 10 "cluster.advertise_host" "loopback" -- \
+  "$bin" learner --config "$config" --run-dir "$work/exposed" --set cluster.advertise_host=10.0.0.5
+expect_error "replay: wildcard bind without CURVE" 10 "--insert-bind" "pamdp keygen" "--curve-keys" "--insecure" -- \
+  "$bin" replay --join tcp://127.0.0.1:1 --insert-bind "tcp://*:0" --join-timeout 2
+expect_error "replay: learner beyond loopback" 10 "--join" "--insecure" -- \
+  "$bin" replay --join tcp://0.0.0.0:1 --join-timeout 2
+expect_error "actor: learner beyond loopback" 10 "--join" "pamdp keygen" "--curve-keys" "--insecure" -- \
+  "$bin" actor --join tcp://0.0.0.0:1 --join-timeout 2
+
+# With cluster.insecure = true the learner starts on a wildcard bind, warns once and exports
+# pamdp_security_insecure 1. Run in a network namespace of its own (only lo), so that the wildcard
+# bind reaches nothing else; skipped where unshare -n is not permitted.
+if command -v unshare >/dev/null && unshare -n true 2>/dev/null; then
+  cases=$((cases + 1))
+  unshare -n bash -c '
+    ip link set lo up
+    "$1" learner --config "$2" --run-dir "$3/insecure" --set cluster.learner_bind=tcp://0.0.0.0:0 \
+      --set cluster.weights_bind=tcp://0.0.0.0:0 --set cluster.insecure=true --set train.max_updates=1 \
+      >"$3/insecure.log" 2>&1 &
+    learner=$!
+    url=""
+    for _ in $(seq 100); do
+      url=$(grep -o "http://127\.0\.0\.1:[0-9]*/metrics" "$3/insecure.log" | head -n 1 || true)
+      [[ -n $url ]] && break
+      sleep 0.1
+    done
+    curl -sf --max-time 2 "$url" | grep "^pamdp_security_insecure " >"$3/insecure.gauge" || true
+    kill -TERM $learner; wait $learner || true' _ "$bin" "$config" "$work"
+  gauge=$(cat "$work/insecure.gauge" 2>/dev/null || true)
+  warnings=$(grep -c "INSECURE" "$work/insecure.log" || true)
+  if [[ $gauge == "pamdp_security_insecure 1" && $warnings == 1 ]]; then
+    printf 'ok    %-34s %s, %d warning line\n' "learner: cluster.insecure = true" "$gauge" "$warnings"
+  else
+    failures=$((failures + 1))
+    echo "FAIL  learner: cluster.insecure = true: gauge '$gauge', $warnings INSECURE warning(s); log:" >&2
+    tail -n 8 "$work/insecure.log" >&2
+  fi
+else
+  echo "skip  learner: cluster.insecure = true (unshare -n not permitted here)"
+fi
 
 # --- a port in use ----------------------------------------------------------------------------
 python3 -c '
