@@ -119,7 +119,11 @@ server_group=${groups[-1]}
 "$bin" eval --env hfo-server --set "env.server_port=$port" --policy scripted --episodes 100000 >"$work/down.out" \
   2>"$work/down.err" &
 eval_pid=$!
-sleep 3
+for _ in $(seq 1 300); do  # until the agent plays (a loaded machine takes seconds to join)
+  grep -q "hfo-server: joined" "$work/down.err" && break
+  sleep 0.2
+done
+sleep 1
 kill -TERM -- "-$server_group"
 status=0
 wait "$eval_pid" || status=$?

@@ -163,6 +163,7 @@ class HfoServerEnv final : public Env {
     client_->connectToServer(::hfo::LOW_LEVEL_FEATURE_SET, config_dir, c_.port, c_.host, c_.team,
                              /*play_goalie=*/false);
     g_connecting_to[0] = '\0';
+    std::fprintf(stderr, "hfo-server: joined %s as unum %d\n", address(c_).c_str(), client_->getUnum());
     const int teammates = client_->getNumTeammates();
     const int opponents = client_->getNumOpponents();
     const auto features = static_cast<int>(client_->getState().size());
