@@ -22,6 +22,7 @@ inline hfo_server::HfoServerConfig server_config(const EnvConfig& c) {
   s.config_dir = c.server_config_dir;
   s.opponents = c.hfo.goalie ? 1 : 0;
   s.max_steps = c.hfo.max_steps;
+  s.connect_timeout_s = c.server_connect_timeout_s;
   return s;
 }
 

@@ -134,6 +134,13 @@ void print_result(const std::string& name, const EvalResult& r, bool json, const
     std::printf(" %s=%d", status.c_str(), count);
   }
   std::printf("\n");
+  if (!r.env_counters.empty()) {
+    std::printf("env counters:");
+    for (const auto& [counter, value] : r.env_counters) {
+      std::printf(" %s=%lld", counter.c_str(), static_cast<long long>(value));
+    }
+    std::printf("\n");
+  }
   if (agreement != nullptr) {
     print_agreement(*agreement, checkpoint);
   }

@@ -46,6 +46,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.choice("env.server_encoding", c.env.server_encoding, server_encoding_choices());
   v.text("env.server_team", c.env.server_team);
   v.text_or_empty("env.server_config_dir", c.env.server_config_dir);
+  v.integer("env.server_connect_timeout_s", c.env.server_connect_timeout_s, 1, 3600);
 
   v.int_list("ddpg.hidden", c.ddpg.hidden, 1, 1 << 16);
   v.real("ddpg.actor_learning_rate", c.ddpg.actor_learning_rate, 0.0, 1.0);

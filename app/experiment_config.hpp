@@ -30,7 +30,8 @@ struct EnvConfig {
   int server_eval_port = 0;
   hfo_server::Encoding server_encoding = hfo_server::Encoding::kNative;
   std::string server_team = "base_left";
-  std::string server_config_dir;  // empty: HFO_ROOT/bin/teams/base/config/formations-dt
+  std::string server_config_dir;      // empty: HFO_ROOT/bin/teams/base/config/formations-dt
+  int server_connect_timeout_s = 30;  // how long an env waits for its server to answer at the first reset()
 };
 
 // Whether the env gives the embedded simulator's features, the ones the scripted offense reads:

@@ -11,7 +11,8 @@
 # runs/hfo-servers. The learner runs with --set env.name=hfo-server (and train.eval_episodes=0,
 # or env.server_eval_port with a server of its own); with --goalie each server gets one goalie
 # (--defense-npcs 1) and the learner needs env.goalie=true. PAMDP_BIN picks the pamdp binary
-# (default build/bin/pamdp; it must be built with -DHFO_ROOT).
+# (default build/bin/pamdp; it must be built with -DHFO_ROOT); servers run as
+# `/usr/bin/python3 HFO/bin/HFO ...` (HFO_PYTHON overrides the interpreter).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -24,7 +25,7 @@ seed=1
 log_dir=runs/hfo-servers
 goalie=0
 
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "hfo-server-actors: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -51,8 +52,10 @@ hfo_root=$(cd "$hfo_root" 2>/dev/null && pwd) || die "--hfo-root: no such direct
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, got '$seed'"
 bin=${PAMDP_BIN:-$root/build/bin/pamdp}
 [[ -x $bin ]] || die "no pamdp binary at $bin (build with -DHFO_ROOT, or set PAMDP_BIN)"
+# bin/HFO starts with '#!/usr/bin/env python', and Debian 12 has no 'python': run it with python3
+# (HFO_PYTHON picks another interpreter; it needs numpy).
 py=""
-for candidate in python3 /usr/bin/python3 python; do
+for candidate in ${HFO_PYTHON:-} /usr/bin/python3 python3; do
   if command -v "$candidate" >/dev/null && "$candidate" -c 'import numpy' 2>/dev/null; then
     py=$candidate
     break

@@ -26,6 +26,13 @@ struct StepResult {
   [[nodiscard]] bool terminal() const { return status != 0; }
 };
 
+// A count an env keeps about its own behaviour, e.g. action parameters it had to clip to a
+// server's range. For eval output and logs; most envs keep none.
+struct EnvCounter {
+  std::string_view name;  // snake_case, e.g. "kick_power_clamped"
+  int64_t value = 0;
+};
+
 class Env {
  public:
   Env() = default;
@@ -45,6 +52,9 @@ class Env {
   [[nodiscard]] virtual std::span<const int> outcomes() const = 0;
   // The terminal status that counts as success (scoring rate), or -1 if none.
   [[nodiscard]] virtual int success_status() const = 0;
+
+  // The env's counters since construction; empty by default. Valid until the next call on the env.
+  [[nodiscard]] virtual std::span<const EnvCounter> counters() const { return {}; }
 
   virtual void reset(uint64_t seed, std::span<float> obs) = 0;
   virtual void reset(std::span<float> obs) = 0;

@@ -31,6 +31,10 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const
   int64_t total_steps = 0;
   int64_t goal_steps = 0;
   int goals = 0;
+  std::vector<int64_t> counters_before;
+  for (const EnvCounter& c : env.counters()) {
+    counters_before.push_back(c.value);
+  }
   for (int ep = 0; ep < episodes; ++ep) {
     if (ep == 0) {
       env.reset(seed, obs);
@@ -83,6 +87,11 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const
     res.avg_steps = static_cast<double>(total_steps) / episodes;
   }
   res.avg_steps_to_goal = goals > 0 ? static_cast<double>(goal_steps) / goals : 0.0;
+  const std::span<const EnvCounter> counters = env.counters();
+  for (size_t i = 0; i < counters.size(); ++i) {
+    res.env_counters[std::string(counters[i].name)] =
+        counters[i].value - (i < counters_before.size() ? counters_before[i] : 0);
+  }
   return res;
 }
 
@@ -94,6 +103,9 @@ std::string to_json(const EvalResult& r) {
   j["avg_return"] = r.avg_return;
   j["avg_steps"] = r.avg_steps;
   j["outcomes"] = r.outcomes;
+  if (!r.env_counters.empty()) {
+    j["env_counters"] = r.env_counters;
+  }
   return j.dump();
 }
 

@@ -22,6 +22,8 @@ struct EvalResult {
   double avg_return = 0.0;
   double avg_steps = 0.0;               // over all episodes
   std::map<std::string, int> outcomes;  // status name -> count (every outcome listed)
+  // The env's counters (Env::counters()) over these episodes; empty for envs that keep none.
+  std::map<std::string, int64_t> env_counters;
 };
 
 // One decision of an evaluation, as `on_step` sees it: the observation the policy read, the

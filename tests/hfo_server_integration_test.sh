@@ -5,7 +5,9 @@
 #   2. runs `pamdp eval --env hfo-server --policy scripted --episodes 5 --json` against another
 #      and checks the JSON line;
 #   3. kills a server under a running eval: pamdp exits non-zero naming SERVER_DOWN;
-#   4. asks for a server where none runs: pamdp exits non-zero saying how to start one.
+#   4. asks for a server where none runs: pamdp exits non-zero within
+#      env.server_connect_timeout_s saying how to start one (with python3);
+#   5. starts an eval together with its server, not waiting for bin/HFO's line: the env waits.
 # Exits 77 (skipped) when no server can be started here: no Python with numpy (bin/HFO imports
 # it), no bin/HFO or rcssserver in HFO_ROOT, or the server never waits for its agent.
 #
@@ -35,7 +37,7 @@ fail() {
 
 [[ -x $hfo_root/bin/HFO && -x $hfo_root/bin/rcssserver ]] || skip "no bin/HFO and bin/rcssserver in $hfo_root (make install in HFO's build)"
 py=""
-for candidate in python3 /usr/bin/python3 python; do
+for candidate in /usr/bin/python3 python3; do  # bin/HFO: not "python" (Debian 12 has none)
   if command -v "$candidate" >/dev/null && "$candidate" -c 'import numpy' 2>/dev/null; then
     py=$candidate
     break
@@ -106,6 +108,8 @@ assert sum(r["outcomes"].values()) == 5, r
 assert set(r["outcomes"]) == {"GOAL", "CAPTURED_BY_DEFENSE", "OUT_OF_BOUNDS", "OUT_OF_TIME"}, r
 assert r["goal_rate"] >= 0.8, r  # the scripted offense scores 300 of 300 on the real server
 assert 30 <= r["avg_steps_to_goal"] <= 150, r
+assert set(r["env_counters"]) == {"kick_power_clamped", "dash_power_clamped", "direction_wrapped"}, r
+assert all(isinstance(v, int) and v >= 0 for v in r["env_counters"].values()), r
 EOF
 echo "eval on the real server: $json"
 
@@ -115,7 +119,11 @@ server_group=${groups[-1]}
 "$bin" eval --env hfo-server --set "env.server_port=$port" --policy scripted --episodes 100000 >"$work/down.out" \
   2>"$work/down.err" &
 eval_pid=$!
-sleep 3
+for _ in $(seq 1 300); do  # until the agent plays (a loaded machine takes seconds to join)
+  grep -q "hfo-server: joined" "$work/down.err" && break
+  sleep 0.2
+done
+sleep 1
 kill -TERM -- "-$server_group"
 status=0
 wait "$eval_pid" || status=$?
@@ -128,10 +136,24 @@ grep -q "SERVER_DOWN" "$work/down.err" || {
 # 4. No server at all.
 port=$(free_port)
 status=0
-"$bin" eval --env hfo-server --set "env.server_port=$port" --episodes 1 >/dev/null 2>"$work/none.err" || status=$?
+"$bin" eval --env hfo-server --set "env.server_port=$port" --set env.server_connect_timeout_s=2 --episodes 1 \
+  >/dev/null 2>"$work/none.err" || status=$?
 ((status != 0)) || fail "pamdp eval succeeded without a server"
-grep -q "no HFO server answers at localhost:$port" "$work/none.err" || {
+grep -q "no HFO server answers at localhost:$port (waited 2 s, env.server_connect_timeout_s)" "$work/none.err" &&
+  grep -q "/usr/bin/python3 .*/bin/HFO --offense-agents 1" "$work/none.err" || {
   cat "$work/none.err" >&2
-  fail "the missing server is not named"
+  fail "the missing server is not named, or not how to start one"
 }
+
+# 5. The agent started together with its server, before bin/HFO waits for it (the env waits).
+port=$(free_port)
+setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 --headless --fullstate --no-logging --frames-per-trial 500 \
+  --port "$port" --seed 14 >"$work/hfo-$port.log" 2>&1 &
+groups+=($!)
+"$bin" eval --env hfo-server --set "env.server_port=$port" --policy scripted --episodes 3 --json >"$work/early.out" \
+  2>"$work/early.err" || {
+  cat "$work/early.err" "$work/hfo-$port.log" >&2
+  fail "pamdp eval started together with its server failed"
+}
+grep -q "answered after .* giving its trainer" "$work/early.err" || fail "the env did not see the server start"
 echo "hfo-server integration: OK"

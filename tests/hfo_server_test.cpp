@@ -6,11 +6,17 @@
 // (left, right) and 1.05 * 68 = 71.4 (top, bottom). E1/E2: R1 = sqrt(52.5^2 + 34^2) = 62.5479816,
 // OOB 52.5 and 68. A proximity is 1 - 2 clamp(d / M, 0, 1).
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/env_factory.hpp"
@@ -20,6 +26,9 @@
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/hfo_server/feature_encoding.hpp"
 #include "envs/hfo_server/hfo_server_env.hpp"
+#include "envs/hfo_server/server_action.hpp"
+#include "envs/hfo_server/server_probe.hpp"
+#include "learner/evaluation.hpp"
 
 namespace pamdp::hfo_server {
 namespace {
@@ -250,6 +259,188 @@ TEST(HfoServerConfig, KeysAreValidatedAndRoundTrip) {
   EXPECT_NE(error_of("env.server_host=''").find("'env.server_host' must be a non-empty string"), std::string::npos);
   EXPECT_NE(error_of("env.name=hfo_server").find("hfo, reach_stop, hfo-server"), std::string::npos);
   EXPECT_NE(error_of("env.server_prot=7000").find("server_port"), std::string::npos);  // lists the valid keys
+  EXPECT_EQ(def.env.server_connect_timeout_s, 30);
+  EXPECT_EQ(app::server_config(app::parse_experiment_config("", "x", {"env.server_connect_timeout_s=5"}).env)
+                .connect_timeout_s,
+            5);
+  EXPECT_NE(error_of("env.server_connect_timeout_s=0").find("'env.server_connect_timeout_s' must be within [1, 3600]"),
+            std::string::npos);
+  EXPECT_NE(error_of("env.server_connect_timeout_s=3601").find("env.server_connect_timeout_s"), std::string::npos);
+}
+
+// Parameters outside the server's ranges reach it clipped (powers) or wrapped (directions), as
+// HFO's client (librcsc) and the embedded simulator treat them, and each one is counted.
+TEST(HfoServerActions, OutOfRangeParametersAreClippedWrappedAndCounted) {
+  ActionClampCounts counts;
+  const auto args = [&](int id, std::array<float, 6> p) { return server_command_args({id, p}, counts); };
+  ServerCommandArgs a = args(hfo::kKick, {0, 0, 0, 0, 100.2F, 30});  // the server log's "com=100.2"
+  EXPECT_EQ(a.p1, 100.0);
+  EXPECT_EQ(a.p2, 30.0);
+  a = args(hfo::kKick, {0, 0, 0, 0, -3, 181});
+  EXPECT_EQ(a.p1, 0.0);
+  EXPECT_NEAR(a.p2, -179.0, 1e-9);
+  EXPECT_EQ(counts.kick_power, 2);
+  EXPECT_EQ(counts.direction, 1);
+  a = args(hfo::kKick, {0, 0, 0, 0, 100, -180});  // both ends are in range
+  EXPECT_EQ(a.p1, 100.0);
+  EXPECT_EQ(a.p2, -180.0);
+  a = args(hfo::kDash, {-100, 180, 0, 0, 500, 500});  // in range; the kick's parameters are not read
+  EXPECT_EQ(a.p1, -100.0);
+  EXPECT_EQ(a.p2, 180.0);
+  EXPECT_EQ(counts.total(), 3);
+  a = args(hfo::kDash, {-100.5F, -270, 0, 0, 0, 0});
+  EXPECT_EQ(a.p1, -100.0);
+  EXPECT_NEAR(a.p2, 90.0, 1e-9);
+  a = args(hfo::kDash, {101, 0, 0, 0, 0, 0});
+  EXPECT_EQ(a.p1, 100.0);
+  EXPECT_EQ(counts.dash_power, 2);
+  EXPECT_NEAR(args(hfo::kTurn, {0, 0, 190, 0, 0, 0}).p1, -170.0, 1e-9);
+  EXPECT_NEAR(args(hfo::kTackle, {0, 0, 0, -540, 0, 0}).p1, 180.0, 1e-9);
+  EXPECT_EQ(args(hfo::kTurn, {0, 0, 12.5F, 0, 0, 0}).p1, 12.5);
+  EXPECT_EQ(counts.kick_power, 2);
+  EXPECT_EQ(counts.dash_power, 2);
+  EXPECT_EQ(counts.direction, 4);
+}
+
+// A UDP socket on 127.0.0.1 that answers every datagram from the `first_answered`-th on (1-based),
+// as rcssserver answers an unknown command; a server that is still starting answers none at first.
+class FakeServer {
+ public:
+  explicit FakeServer(int first_answered) : fd_(socket(AF_INET, SOCK_DGRAM, 0)) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof(a);
+    if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&a), len) != 0 ||
+        getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+      throw std::runtime_error("FakeServer: cannot bind a UDP socket on 127.0.0.1");
+    }
+    port_ = ntohs(a.sin_port);
+    thread_ = std::thread([this, first_answered] {
+      for (int received = 0; !stop_.load();) {
+        pollfd p{fd_, POLLIN, 0};
+        if (poll(&p, 1, 50) <= 0) {
+          continue;
+        }
+        sockaddr_in from{};
+        socklen_t from_len = sizeof(from);
+        std::array<char, 256> buf{};
+        if (recvfrom(fd_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len) > 0 &&
+            ++received >= first_answered) {
+          static constexpr char kReply[] = "(error unknown_command)";
+          (void)sendto(fd_, kReply, sizeof(kReply), 0, reinterpret_cast<sockaddr*>(&from), from_len);
+        }
+      }
+    });
+  }
+  FakeServer(const FakeServer&) = delete;
+  FakeServer& operator=(const FakeServer&) = delete;
+  ~FakeServer() {
+    stop_ = true;
+    thread_.join();
+    close(fd_);
+  }
+  [[nodiscard]] int port() const { return port_; }
+
+ private:
+  int fd_;
+  int port_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+TEST(HfoServerProbe, AServerUpAlreadyIsJoinedAtOnce) {
+  const FakeServer server(1);
+  const ServerProbe probe = probe_server("127.0.0.1", server.port(), 5.0);
+  EXPECT_TRUE(probe.answered);
+  EXPECT_TRUE(probe.answered_at_once);
+  EXPECT_LT(probe.waited_s, 0.5);
+}
+
+// The retry: a server that does not answer the first two probes (one still starting) is waited
+// for, and the env then knows it came up late (and gives its trainer time to fill the NPC slots).
+TEST(HfoServerProbe, AServerThatComesUpWhileWaitingIsWaitedFor) {
+  const FakeServer server(3);
+  const ServerProbe probe = probe_server("127.0.0.1", server.port(), 5.0);
+  EXPECT_TRUE(probe.answered);
+  EXPECT_FALSE(probe.answered_at_once);
+  EXPECT_GT(probe.waited_s, 0.9);  // two unanswered probes, 0.5 s apart
+  EXPECT_LT(probe.waited_s, 3.0);
+}
+
+TEST(HfoServerProbe, NoServerTimesOutWithTheFixNamed) {
+  int port = 0;
+  {
+    const FakeServer gone(1);  // a port that was free a moment ago and is closed again
+    port = gone.port();
+  }
+  const ServerProbe probe = probe_server("127.0.0.1", port, 1.0);
+  EXPECT_FALSE(probe.answered);
+  EXPECT_GE(probe.waited_s, 1.0);
+  EXPECT_LT(probe.waited_s, 2.0);
+
+  HfoServerConfig c;
+  c.port = port;
+  c.opponents = 1;
+  c.connect_timeout_s = 1;
+  const std::string message = no_server_message(c, "/opt/HFO");
+  const std::string where = "localhost:" + std::to_string(port);
+  EXPECT_NE(message.find("no HFO server answers at " + where + " (waited 1 s, env.server_connect_timeout_s)"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("/usr/bin/python3 /opt/HFO/bin/HFO --offense-agents 1 --defense-npcs 1"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("--port " + std::to_string(port)), std::string::npos) << message;
+  EXPECT_NE(message.find("Waiting for player-controlled agent"), std::string::npos) << message;
+}
+
+// An env's counters reach the evaluation result (and its JSON) as counts over the evaluated
+// episodes; envs without counters add no key, so their JSON is unchanged.
+TEST(HfoServerActions, EnvCountersReachTheEvaluationResult) {
+  class CountingEnv final : public Env {
+   public:
+    [[nodiscard]] std::string_view name() const override { return "counting"; }
+    [[nodiscard]] const ActionSpace& action_space() const override { return hfo::hfo_action_space(); }
+    [[nodiscard]] int observation_size() const override { return 1; }
+    [[nodiscard]] int max_episode_steps() const override { return 3; }
+    [[nodiscard]] std::string_view status_name(int s) const override { return s == 0 ? "IN_GAME" : "GOAL"; }
+    [[nodiscard]] std::span<const int> outcomes() const override {
+      static constexpr std::array<int, 2> kOutcomes{0, 1};
+      return kOutcomes;
+    }
+    [[nodiscard]] int success_status() const override { return 1; }
+    [[nodiscard]] std::span<const EnvCounter> counters() const override {
+      counters_[0] = {"kick_power_clamped", clamps_.kick_power};
+      return counters_;
+    }
+    void reset(uint64_t /*seed*/, std::span<float> obs) override { reset(obs); }
+    void reset(std::span<float> obs) override { obs[0] = 0.0F; }
+    StepResult step(const ParamAction& action, std::span<float> obs) override {
+      (void)server_command_args(action, clamps_);
+      obs[0] = 0.0F;
+      return {0.0F, 1};
+    }
+
+   private:
+    ActionClampCounts clamps_;
+    mutable std::array<EnvCounter, 1> counters_{};
+  };
+  class OverPowerKick final : public Policy {
+   public:
+    ParamAction act(std::span<const float> /*obs*/) override { return {hfo::kKick, params_}; }
+
+   private:
+    std::array<float, 6> params_{0, 0, 0, 0, 100.2F, 0};
+  };
+  CountingEnv env;
+  OverPowerKick policy;
+  (void)evaluate(env, policy, 2, 1);
+  const EvalResult r = evaluate(env, policy, 3, 1);  // counts these 3 episodes, not the 2 before
+  EXPECT_EQ(r.env_counters.at("kick_power_clamped"), 3);
+  EXPECT_NE(to_json(r).find("\"env_counters\":{\"kick_power_clamped\":3}"), std::string::npos) << to_json(r);
+  EvalResult none = r;
+  none.env_counters.clear();
+  EXPECT_EQ(to_json(none).find("env_counters"), std::string::npos);
 }
 
 // Widths come from the env: 59 native / 58 embedded in 1v0, 68 / 66 with a goalie.

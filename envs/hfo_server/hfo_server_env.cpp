@@ -2,10 +2,6 @@
 // path); hfo_server_unavailable.cpp stands in for it otherwise.
 #include "envs/hfo_server/hfo_server_env.hpp"
 
-#include <netdb.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
 #include <HFO.hpp>
 
 #include <algorithm>
@@ -15,12 +11,15 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/hfo_server/feature_encoding.hpp"
+#include "envs/hfo_server/server_action.hpp"
+#include "envs/hfo_server/server_probe.hpp"
 
 namespace pamdp::hfo_server {
 namespace {
@@ -41,15 +40,6 @@ std::string address(const HfoServerConfig& c) {
   return c.host + ":" + std::to_string(c.port);
 }
 
-std::string how_to_start(const HfoServerConfig& c) {
-  return "start one first, e.g. " PAMDP_HFO_ROOT "/bin/HFO --offense-agents 1" +
-         std::string(c.opponents > 0 ? " --defense-npcs " + std::to_string(c.opponents) : "") +
-         " --fullstate --headless --no-logging --frames-per-trial " + std::to_string(c.max_steps) + " --port " +
-         std::to_string(c.port) +
-         " --seed S, and wait for its line 'Waiting for player-controlled agent' "
-         "(one server per env, ports at least 3 apart; docs/hfo-server.md)";
-}
-
 // HFO's client library calls exit(1) when it cannot start (it has no error return). While a
 // connection is being made, this says which server and what to do before the process ends.
 char g_connecting_to[512] = {};
@@ -58,50 +48,23 @@ extern "C" void explain_exit_while_connecting() {
     std::fprintf(stderr,
                  "hfo-server: HFO's client library gave up connecting to %s (its message above). Connect only "
                  "after bin/HFO has printed 'Waiting for player-controlled agent' (an agent that joins earlier takes "
-                 "an NPC's place and the game never starts), and to a server whose agent slot is free.\n",
+                 "an NPC's place, the trainer disconnects it and the game never starts), and to a server whose agent "
+                 "slot is free. That server cannot be used any more: stop its bin/HFO and start a fresh one.\n",
                  g_connecting_to);
   }
 }
 
-// rcssserver answers any unknown datagram on its player port with "(error unknown_command)", so
-// one probe tells whether a server listens there without joining its game. Retried every 0.5 s
-// for `connect_wait_s` seconds (a server that is still starting up answers late).
-void probe_server(const HfoServerConfig& c) {
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_DGRAM;
-  addrinfo* found = nullptr;
-  const std::string port = std::to_string(c.port);
-  if (const int rc = getaddrinfo(c.host.c_str(), port.c_str(), &hints, &found); rc != 0) {
-    throw std::runtime_error("hfo-server: cannot resolve env.server_host '" + c.host + "': " + gai_strerror(rc));
+// Waits for the server to answer (up to c.connect_timeout_s), and if it was only starting, for
+// its trainer to fill the NPC slots (server_probe.hpp says what joining earlier does).
+void wait_for_server(const HfoServerConfig& c) {
+  const ServerProbe probe = probe_server(c.host, c.port, c.connect_timeout_s);
+  if (!probe.answered) {
+    throw std::runtime_error(no_server_message(c, PAMDP_HFO_ROOT));
   }
-  const int fd = socket(found->ai_family, found->ai_socktype, found->ai_protocol);
-  const bool connected = fd >= 0 && ::connect(fd, found->ai_addr, found->ai_addrlen) == 0;
-  freeaddrinfo(found);
-  if (!connected) {
-    if (fd >= 0) {
-      close(fd);
-    }
-    throw std::runtime_error("hfo-server: cannot open a UDP socket to " + address(c));
-  }
-  static constexpr char kProbe[] = "(pamdp_probe)";
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(c.connect_wait_s);
-  bool answered = false;
-  while (!answered && std::chrono::steady_clock::now() < deadline) {
-    (void)send(fd, kProbe, sizeof(kProbe), 0);
-    pollfd p{fd, POLLIN, 0};
-    if (poll(&p, 1, 500) > 0) {
-      std::array<char, 256> reply{};
-      answered = recv(fd, reply.data(), reply.size(), 0) > 0;  // refused (ICMP) reads as -1
-      if (!answered) {
-        usleep(500 * 1000);
-      }
-    }
-  }
-  close(fd);
-  if (!answered) {
-    throw std::runtime_error("hfo-server: no HFO server answers at " + address(c) + " (waited " +
-                             std::to_string(c.connect_wait_s) + " s); " + how_to_start(c));
+  if (!probe.answered_at_once) {
+    std::fprintf(stderr, "hfo-server: %s answered after %.1f s; giving its trainer %.0f s to fill its NPC slots\n",
+                 address(c).c_str(), probe.waited_s, kTrainerFillS);
+    std::this_thread::sleep_for(std::chrono::duration<double>(kTrainerFillS));
   }
 }
 
@@ -131,6 +94,12 @@ class HfoServerEnv final : public Env {
     return kOutcomes;
   }
   [[nodiscard]] int success_status() const override { return hfo::kGoal; }
+  [[nodiscard]] std::span<const EnvCounter> counters() const override {
+    counters_ = {{{"kick_power_clamped", clamps_.kick_power},
+                  {"dash_power_clamped", clamps_.dash_power},
+                  {"direction_wrapped", clamps_.direction}}};
+    return counters_;
+  }
 
   // The server's --seed governs its episodes; a seed cannot be sent to it.
   void reset(uint64_t /*seed*/, std::span<float> obs) override { reset(obs); }
@@ -155,13 +124,15 @@ class HfoServerEnv final : public Env {
     if (action.params.size() < static_cast<size_t>(hfo::param::kCount)) {
       misuse("step(): the parameter vector must hold the 6 HFO parameters");
     }
-    const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
+    if (action.id < hfo::kDash || action.id > hfo::kKick) {
+      misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
+    }
+    const ServerCommandArgs a = server_command_args(action, clamps_);
     switch (action.id) {
-      case hfo::kDash: client_->act(::hfo::DASH, p(hfo::param::kDashPower), p(hfo::param::kDashDir)); break;
-      case hfo::kTurn: client_->act(::hfo::TURN, p(hfo::param::kTurnDir)); break;
-      case hfo::kTackle: client_->act(::hfo::TACKLE, p(hfo::param::kTackleDir)); break;
-      case hfo::kKick: client_->act(::hfo::KICK, p(hfo::param::kKickPower), p(hfo::param::kKickDir)); break;
-      default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
+      case hfo::kDash: client_->act(::hfo::DASH, a.p1, a.p2); break;
+      case hfo::kTurn: client_->act(::hfo::TURN, a.p1); break;
+      case hfo::kTackle: client_->act(::hfo::TACKLE, a.p1); break;
+      default: client_->act(::hfo::KICK, a.p1, a.p2); break;
     }
     int status = server_step();
     ++steps_;
@@ -184,7 +155,7 @@ class HfoServerEnv final : public Env {
       throw std::runtime_error("hfo-server: env.server_config_dir '" + config_dir +
                                "' is not a directory; point it at HFO's bin/teams/base/config/formations-dt");
     }
-    probe_server(c_);
+    wait_for_server(c_);
     static const bool registered = std::atexit(explain_exit_while_connecting) == 0;
     (void)registered;
     std::snprintf(g_connecting_to, sizeof(g_connecting_to), "%s", address(c_).c_str());
@@ -192,6 +163,7 @@ class HfoServerEnv final : public Env {
     client_->connectToServer(::hfo::LOW_LEVEL_FEATURE_SET, config_dir, c_.port, c_.host, c_.team,
                              /*play_goalie=*/false);
     g_connecting_to[0] = '\0';
+    std::fprintf(stderr, "hfo-server: joined %s as unum %d\n", address(c_).c_str(), client_->getUnum());
     const int teammates = client_->getNumTeammates();
     const int opponents = client_->getNumOpponents();
     const auto features = static_cast<int>(client_->getState().size());
@@ -216,7 +188,7 @@ class HfoServerEnv final : public Env {
     if (s == ::hfo::SERVER_DOWN) {
       throw std::runtime_error("hfo-server: the HFO server at " + address(c_) +
                                " went down (SERVER_DOWN): it stops when its game ends or its process dies; " +
-                               how_to_start(c_));
+                               how_to_start(c_, PAMDP_HFO_ROOT));
     }
     return static_cast<int>(s);
   }
@@ -252,6 +224,8 @@ class HfoServerEnv final : public Env {
   std::unique_ptr<::hfo::HFOEnvironment> client_;
   std::vector<float> embedded_;  // the 58-feature view: the reward's input in both encodings
   hfo::ShapedReward reward_;
+  ActionClampCounts clamps_;
+  mutable std::array<EnvCounter, 3> counters_{};
   int steps_ = 0;
   bool at_episode_start_ = false;
   bool episode_over_ = false;

@@ -19,8 +19,13 @@
 //    in case the server allows longer trials.
 //  - The reward is the embedded env's (reference §6.2, hfo::ShapedReward), always computed from
 //    the 58-feature encoding, whichever encoding the agent sees.
-//  - A server that goes down (SERVER_DOWN) or never answers is a std::runtime_error naming
-//    host:port and how to start one.
+//  - The first reset() waits up to connect_timeout_s for the server to answer (server_probe.hpp);
+//    one that came up while it waited gets kTrainerFillS more to fill its NPC slots. A server
+//    that goes down (SERVER_DOWN) or never answers is a std::runtime_error naming host:port and
+//    how to start one.
+//  - Parameters outside the server's ranges are clipped or wrapped as HFO's client would
+//    (server_action.hpp) and counted: counters() gives kick_power_clamped, dash_power_clamped
+//    and direction_wrapped since construction.
 //  - Not thread-safe; one env per thread (HFO's client keeps process-wide parameter singletons,
 //    so one env per process is the tested case).
 #pragma once
@@ -46,10 +51,16 @@ struct HfoServerConfig {
   std::string team = "base_left";  // HFO's offense team name
   // agent2d formation files; empty: the HFO_ROOT given to CMake + bin/teams/base/config/formations-dt.
   std::string config_dir;
-  int opponents = 0;        // defense players on the server: 1 with bin/HFO --defense-npcs 1 (a goalie)
-  int max_steps = 500;      // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
-  int connect_wait_s = 10;  // how long the first reset() waits for a server to answer
+  int opponents = 0;           // defense players on the server: 1 with bin/HFO --defense-npcs 1 (a goalie)
+  int max_steps = 500;         // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
+  int connect_timeout_s = 30;  // how long the first reset() waits for a server to answer (env.server_connect_timeout_s)
 };
+
+// How long a server that came up while the first reset() waited is given to fill its NPC slots
+// before the agent joins (an agent that joins earlier breaks the server, server_probe.hpp). No
+// message tells when bin/HFO's trainer is done; it took 0.7 s for the 10 offense slots on 2
+// cores running two other jobs, and more than 3.5 s at a load average of 12 (docs/hfo-server.md).
+inline constexpr double kTrainerFillS = 10.0;
 
 // Observation width for `config` (native: 59 + 9 * opponents; embedded: 58 + 8 * opponents).
 inline int observation_size(const HfoServerConfig& config) {
