@@ -56,7 +56,7 @@ wait_for() {
   shift 2
   local deadline=$(($(date +%s) + seconds))
   until eval "$*"; do
-    (($(date +%s) < deadline)) || fail "$what (not within ${seconds}s)"
+    (($(date +%s) < deadline)) || fail "$(eval "echo \"$what\"") (not within ${seconds}s)"
     sleep 0.5
   done
 }
@@ -75,7 +75,7 @@ if ! docker info >/dev/null 2>&1; then
   dockerd --data-root "$root" --exec-root "$work/exec" --pidfile "$work/dockerd.pid" --host "$DOCKER_HOST" \
     --bridge=none --iptables=false --ip6tables=false >"$work/dockerd.log" 2>&1 &
   dockerd_pid=$!
-  wait_for 60 "dockerd did not answer: $(tail -n 3 "$work/dockerd.log")" 'docker info >/dev/null 2>&1'
+  wait_for 60 'dockerd did not answer: $(tail -n 3 "$work/dockerd.log")' 'docker info >/dev/null 2>&1'
   echo "dockerd started at $(since) (data root $root)"
 fi
 
@@ -147,10 +147,10 @@ run actor-1 actor --join "$join" --curve-keys /keys --seed 1001
 wait_for 60 "the learner listed no metrics URL" '[[ -s $work/runs/exp/metrics_urls.txt ]]'
 lurl=$(head -n 1 "$work/runs/exp/metrics_urls.txt")
 peers() { metric "$lurl" pamdp_learner_peers_connected "role=\"$1\""; }
-wait_for 60 "the learner counts $(peers replay) shards and $(peers actor) actors, not 1 and 2" \
+wait_for 60 'the learner counts $(peers replay) shards and $(peers actor) actors, not 1 and 2' \
   '[[ $(peers replay) == 1 && $(peers actor) == 2 ]]'
 u0=$(metric "$lurl" pamdp_updates_total)
-wait_for 60 "the learner's updates stuck at $(metric "$lurl" pamdp_updates_total)" \
+wait_for 60 "the learner's updates stuck at \$(metric \"\$lurl\" pamdp_updates_total)" \
   "gt \"\$(metric \"\$lurl\" pamdp_updates_total)\" $((${u0%.*} + 2000))"
 joined=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "actors_joined") c = i; next } { v = $c } END { print v }' \
   "$work/runs/exp/metrics.csv")
