@@ -14,6 +14,7 @@
 
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/geometry.hpp"
+#include "envs/hfo/goalie.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/hfo/soccer_sim.hpp"
@@ -60,26 +61,39 @@ TEST(HfoGoalie, OffByDefaultSo1v0Keeps58Features) {
 }
 
 TEST(HfoGoalie, StartsAtGoalCentreEveryEpisode) {
-  HfoEnv env(goalie_config(true));
+  HfoEnv env(goalie_config(false));
   ASSERT_EQ(env.observation_size(), 66);
   std::vector<float> obs(66);
   std::array<float, param::kCount> params{};
-  double body_before_reset = 0.0;
+  double body_before_reset = kGoalieStartBodyDeg;
   for (int ep = 0; ep < 3; ++ep) {
     env.reset(static_cast<uint64_t>(ep) + 5, obs);
-    const PlayerState& g = env.sim().state().players[kGoalieIndex];
-    EXPECT_EQ(env.sim().state().num_players, 2);
-    EXPECT_EQ(g.pos.x, 52.5);
-    EXPECT_EQ(g.pos.y, 0.0);
-    EXPECT_TRUE(g.vel.is_zero());
-    if (ep == 0) {
-      EXPECT_EQ(g.body_deg, 180.0);
-    } else {
-      EXPECT_EQ(g.body_deg, body_before_reset) << "HFO leaves the goalie's body as it was";
+    const SoccerState& s = env.sim().state();
+    EXPECT_EQ(s.num_players, 2);
+    // The first observation comes two cycles after the reset, as HFO's client's does; only the
+    // goalie has moved. The same two cycles from (52.5, 0) at rest, full stamina, the body it
+    // had, must give the same goalie.
+    EXPECT_EQ(s.cycle, kCyclesBeforeFirstObservation);
+    SoccerSim replay(goalie_config(false), 0);
+    PlayerState agent = s.players[0];
+    replay.set_state(agent, BallState{s.ball.pos, {0.0, 0.0}});
+    PlayerState g0 = replay.state().players[kGoalieIndex];
+    g0.body_deg = body_before_reset;
+    replay.set_goalie(g0);
+    for (int k = 0; k < kCyclesBeforeFirstObservation; ++k) {
+      replay.step();
     }
+    const PlayerState& g = s.players[kGoalieIndex];
+    const PlayerState& want = replay.state().players[kGoalieIndex];
+    EXPECT_EQ(g.pos.x, want.pos.x);
+    EXPECT_EQ(g.pos.y, want.pos.y);
+    EXPECT_EQ(g.body_deg, want.body_deg) << "HFO leaves the goalie's body as it was at the reset";
+    EXPECT_EQ(g.stamina, want.stamina);
+    EXPECT_LT((g.pos - kGoalieStart).r(), 1.0);
+    EXPECT_TRUE(s.ball.vel.is_zero());
+    EXPECT_TRUE(s.players[0].vel.is_zero());
     EXPECT_EQ(g.team, Team::kDefense);
     EXPECT_TRUE(g.goalie);
-    EXPECT_EQ(g.stamina, kStaminaMax);
     for (int k = 0; k < 30; ++k) {
       if (env.step(no_op(params), obs).terminal()) {
         break;
@@ -87,6 +101,26 @@ TEST(HfoGoalie, StartsAtGoalCentreEveryEpisode) {
     }
     body_before_reset = env.sim().state().players[kGoalieIndex].body_deg;
   }
+}
+
+// A tackle freeze outlives the reset, as Player::place leaves it (real goalie transitions rows
+// 174-180: frozen from its tackle in cycle 41125 to cycle 41134, across a reset).
+TEST(HfoGoalie, TackleFreezeAndCatchMemoryCarryOverTheReset) {
+  SoccerSim sim(goalie_config(false), 1);
+  sim.reset_episode();
+  PlayerState g = sim.state().players[kGoalieIndex];
+  g.tackle_cycles = 6;
+  g.since_catch = 2;
+  sim.set_goalie(g);
+  sim.mutable_state().ball_caught = true;
+  sim.reset_episode();
+  const PlayerState& after = sim.state().players[kGoalieIndex];
+  // One cycle the server waits after the terminal state, then the two before the observation.
+  EXPECT_EQ(after.tackle_cycles, 6 - 1 - kCyclesBeforeFirstObservation);
+  EXPECT_EQ(after.since_catch, 2 + 1 + kCyclesBeforeFirstObservation);
+  EXPECT_FALSE(sim.state().ball_caught) << "the reset's play_on ends the goalie's catch play mode";
+  EXPECT_EQ(after.pos.x, kGoalieStart.x) << "frozen: it could not move in the first two cycles";
+  EXPECT_EQ(after.pos.y, kGoalieStart.y);
 }
 
 // agent2d's basic position (Bhv_GoalieBasicMove::getTargetPoint): for a ball at rest at
@@ -180,8 +214,12 @@ TEST(HfoGoalie, CaughtBallFliesOnInHfoMode) {
   g.vel = {0.0, 0.1344};
   g.body_deg = 90.0;
   sim.set_goalie(g);
-  ASSERT_TRUE(sim.goalie_catch(kGoalieIndex, 88.7726));
+  // The goalie's own decision this cycle is the recorded catch (its command is the cycle's).
+  const GoalieCommand c = decide_goalie(sim.state(), kGoalieIndex, false);
+  ASSERT_EQ(c.kind, GoalieCommand::Kind::kCatch);
+  EXPECT_NEAR(c.p1, 88.7726, 1e-2);  // the logged state is rounded to 1e-4
   EXPECT_EQ(sim.step(), kInGame);
+  EXPECT_TRUE(sim.state().ball_caught) << "it heard goalie_catch_ball_r: the set play's move until the reset";
   const PlayerState& after = sim.state().players[kGoalieIndex];
   EXPECT_NEAR(after.pos.x, 49.2903, 2e-4);
   EXPECT_NEAR(after.pos.y, 5.7541, 2e-4);

@@ -146,9 +146,17 @@ double dist_thr_of(const GoalieWorld& w, double rate) {
   return std::max(0.5, w.ball_dist_from_self * rate);
 }
 
-// Bhv_GoalieBasicMove::doGoToPointLookBall in play_on: Bhv_GoToPointLookBall.
+// Bhv_GoalieBasicMove::doGoToPointLookBall: in play_on Bhv_GoToPointLookBall; in any other
+// play mode (here: after its own catch) Body_GoToPoint with its default arguments, or else
+// Body_TurnToAngle to the ball's direction, the body angle every caller passes.
 void go_to_point_look_ball(const Context& c, Vec2 target, double dist_thr, double dash_power) {
-  agent2d::go_to_point_look_ball(c.w, target, dist_thr, dash_power, 0.7, c.out);
+  if (!c.w.catch_mode) {
+    agent2d::go_to_point_look_ball(c.w, target, dist_thr, dash_power, 0.7, c.out);
+    return;
+  }
+  if (!agent2d::body_go_to_point(c.w, target, dist_thr, dash_power, -1.0, 100, true, 15.0, c.out)) {
+    agent2d::body_turn_to_angle(c.w, c.w.ball_angle_from_self_deg, c.out);
+  }
 }
 
 bool prepare_deep_cross(const Context& c, Vec2 move_point) {
@@ -528,6 +536,7 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_
   w.ball_pos = mirror(s.ball.pos);
   w.ball_vel = mirror(s.ball.vel);
   w.since_catch = me.since_catch;
+  w.catch_mode = s.ball_caught;
   w.player_rand = server_noise ? kPlayerRand : 0.0;
   w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {
@@ -560,6 +569,26 @@ GoalieCommand decide_goalie(const SoccerState& s, int goalie, bool server_noise)
   const GoalieWorld w = goalie_world(s, goalie, server_noise);
   if (w.self.frozen) {
     return {};  // librcsc refuses every body command while the tackle freezes the player
+  }
+  if (w.catch_mode) {
+    // Not play_on: SamplePlayer runs Bhv_SetPlay, which gives the goalie Bhv_GoalieFreeKick.
+    // Without the ball kickable that is Bhv_GoalieBasicMove, with no catch and no chase.
+    if (w.self_kickable) {
+      // Bhv_GoalieFreeKick::doWait (its first two cycles): face the field. Its later moves
+      // and kick are not carried over: HFO's referee ends the episode when the ball is
+      // within the goalie's kickable area, so in play this branch is reached only from a
+      // state set by hand.
+      Command out;
+      const double line_x = kOurPenaltyLineX;
+      const Vec2 face = w.self.pos.x > line_x - kBallSize - kPlayerSize - 0.5 ? Vec2{line_x - 1.0, 0.0} : Vec2{};
+      agent2d::body_turn_to_point(w, face, 1, &out);
+      return out;
+    }
+    InterceptTable table;
+    agent2d::predict_ball_and_opponents(w, &table);
+    Command out;
+    basic_move(Context{w, table, &out});
+    return out;
   }
   // RoleGoalie::execute.
   if (w.since_catch > kCatchBanCycles && w.ball_dist_from_self < agent2d::kCatchableArea - 0.05 &&

@@ -5,7 +5,8 @@
 // (tests/hfo_goalie_real_data_test.cpp, docs/simulator.md).
 //
 // decide_goalie() is a pure function of the state at the start of a cycle plus the memory the
-// real goalie keeps, which lives in the state (PlayerState::since_catch). It returns the
+// real goalie keeps, which lives in the state (PlayerState::since_catch, and
+// SoccerState::ball_caught for the play mode it believes in after a catch). It returns the
 // command the goalie's client sends to the server, in the server's units (dash power and
 // direction after librcsc's client adjustments, turn moment, catch direction relative to the
 // body), which SoccerSim then executes with the server's handling. It draws no random numbers
@@ -22,6 +23,10 @@
 //     crosses its line), and else it keeps its basic position (Bhv_GoalieBasicMove: on the
 //     line from the ball to a point 7 m behind the goal centre, at x = 2.7 m in front of the
 //     goal line, turning to face across the goal when there).
+// While frozen by its own tackle it sends no body command. After a successful catch it hears
+// the referee's goalie_catch_ball_r and, the ball flying on in HFO mode, keeps that play mode
+// to the end of the episode: then it only keeps its basic position (Bhv_GoalieFreeKick ->
+// Bhv_GoalieBasicMove, going with Body_GoToPoint instead of Bhv_GoToPointLookBall).
 #pragma once
 
 #include "envs/hfo/goalie_world.hpp"

@@ -110,15 +110,29 @@ void SoccerSim::reset_episode() {
   first_episode_ = false;
 
   // HFO's reset places the goalie at (52.5, 0) at rest with full stamina but leaves its body
-  // as it was (HFORef::resetField places players; the body angle is not touched).
-  const double goalie_body = state_.players[kGoalieIndex].body_deg;
-  const bool carry_goalie = config_.goalie;  // the constructor's set_state gave it 180 to start
+  // as it was (HFORef::resetField calls Player::place, which sets position and velocity only,
+  // and recoverAll, which restores stamina, effort and recovery). Its tackle freeze and catch
+  // ban run on, and so does its own catch memory. The cycle the server waits after the
+  // terminal state (HFORef::analyse) counts for them; the goalie's command in that cycle is
+  // not played here.
+  const PlayerState old_goalie = state_.players[kGoalieIndex];
   PlayerState fresh;
   fresh.pos = {ax, ay};
   fresh.body_deg = body;
   set_state(fresh, BallState{{bx, by}, {0.0, 0.0}});
-  if (carry_goalie) {
-    state_.players[kGoalieIndex].body_deg = goalie_body;
+  if (!config_.goalie) {
+    return;
+  }
+  PlayerState& g = state_.players[kGoalieIndex];
+  g.body_deg = old_goalie.body_deg;  // the constructor's set_state gave it 180 to start
+  g.tackle_cycles = std::max(0, old_goalie.tackle_cycles - 1);
+  g.catch_ban = std::max(0, old_goalie.catch_ban - 1);
+  g.since_catch = std::min(PlayerState::kNoCatchYet, old_goalie.since_catch + 1);
+  // HFO's client plays NOOPs for the first two cycles of an episode, so its first observation
+  // comes two cycles after the reset (docs/hfo-server.md); the goalie plays in both. Only the
+  // goalie moves: the ball is at rest and the agent sends nothing.
+  for (int i = 0; i < kCyclesBeforeFirstObservation; ++i) {
+    step();
   }
 }
 

@@ -67,6 +67,9 @@ inline constexpr int kGoalieIndex = 1;
 // Where HFO puts the goalie at every reset (reference §5.1), facing the field.
 inline constexpr Vec2 kGoalieStart{kPitchHalfLength, 0.0};
 inline constexpr double kGoalieStartBodyDeg = 180.0;
+// Cycles between HFO's reset and its client's first observation (two NOOPs). With a goalie
+// they are played at every reset_episode(): the goalie moves in them.
+inline constexpr int kCyclesBeforeFirstObservation = 2;
 
 enum class Team : uint8_t { kOffense, kDefense };
 

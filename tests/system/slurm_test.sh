@@ -78,11 +78,16 @@ wait_for() {
 gt() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 > b + 0) }'; }
 ge() { awk -v a="${1:-}" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 >= b + 0) }'; }
 
-# Five consecutive free TCP ports (slurmctld, slurmd n1 and n2, the learner's join and weights).
-port_free() { ! ss -Htln "sport = :$1" | grep -q .; }
+# Five consecutive free TCP ports (slurmctld, slurmd n1 and n2, the learner's join and weights),
+# below the kernel's ephemeral range: the replay shards and every other test bind port 0 and
+# get theirs from that range, and one took the learner's port between this check and its bind
+# while ctest ran tests beside this one.
+port_free() { ! ss -Htan "sport = :$1" | grep -q .; }
+read -r eph_low _ </proc/sys/net/ipv4/ip_local_port_range 2>/dev/null || eph_low=32768
+top=$((eph_low > 12000 ? eph_low - 10 : 32000))
 base=""
 for _ in $(seq 50); do
-  b=$((20000 + RANDOM % 30000))
+  b=$((10000 + RANDOM % (top - 10000)))
   if port_free "$b" && port_free $((b + 1)) && port_free $((b + 2)) && port_free $((b + 3)) && port_free $((b + 4)); then
     base=$b
     break
