@@ -3,6 +3,7 @@
 #include "envs/hfo/goalie.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 
@@ -307,6 +308,235 @@ double tackle_probability(const GoalieWorld& w) {
   return fail >= 1.0 ? 0.0 : std::max(0.0, 1.0 - fail);
 }
 
+// --- TackleGenerator (HFO src/chain_action/tackle_generator.cpp, its active branches) ------
+
+// librcsc Segment2D, as far as the generator uses it.
+struct Segment {
+  Vec2 origin;
+  Vec2 terminal;
+  [[nodiscard]] bool contains(Vec2 p) const {
+    constexpr double kCalcError = 1.0e-9;  // Segment2D::CALC_ERROR
+    return (p.x - origin.x) * (p.x - terminal.x) <= kCalcError && (p.y - origin.y) * (p.y - terminal.y) <= kCalcError;
+  }
+  [[nodiscard]] Vec2 intersection(const Line& l) const {
+    const Vec2 p = Line::through(origin, terminal).intersection(l);
+    return valid(p) && contains(p) ? p : Vec2{kErrorValue, kErrorValue};
+  }
+};
+
+// Rect2D::intersection(Line2D) for the pitch: the edges in librcsc's order (left, right, top,
+// bottom), at most two points, one when both are the same corner.
+int pitch_intersections(const Line& l, std::array<Vec2, 2>* sol) {
+  constexpr double kL = -kPitchHalfLength;
+  constexpr double kR = kPitchHalfLength;
+  constexpr double kT = -kPitchHalfWidth;
+  constexpr double kB = kPitchHalfWidth;
+  int n = 0;
+  const auto edge = [&](Segment e, bool side) {
+    if (n >= 2) {
+      return;
+    }
+    const Vec2 p = e.intersection(l);
+    if (valid(p) && (side ? (kT <= p.y && p.y <= kB) : (kL <= p.x && p.x <= kR))) {
+      (*sol)[static_cast<size_t>(n++)] = p;
+    }
+  };
+  edge({{kL, kT}, {kL, kB}}, true);
+  edge({{kR, kT}, {kR, kB}}, true);
+  edge({{kL, kT}, {kR, kT}}, false);
+  edge({{kL, kB}, {kR, kB}}, false);
+  if (n == 2 && std::fabs((*sol)[0].x - (*sol)[1].x) < 1.0e-5 && std::fabs((*sol)[0].y - (*sol)[1].y) < 1.0e-5) {
+    n = 1;
+  }
+  return n;
+}
+
+// Rect2D::intersection for a ray or a segment: the line's points that lie on it.
+template <typename On>
+int pitch_intersections(const Line& l, On on, Vec2* first) {
+  std::array<Vec2, 2> sol{};
+  int n = pitch_intersections(l, &sol);
+  if (n > 1 && !on(sol[1])) {
+    --n;
+  }
+  if (n > 0 && !on(sol[0])) {
+    sol[0] = sol[1];
+    --n;
+  }
+  *first = sol[0];
+  return n;
+}
+
+bool out_of_pitch(Vec2 p) {
+  return std::fabs(p.x) > kPitchHalfLength || std::fabs(p.y) > kPitchHalfWidth;
+}
+
+Vec2 ball_after(Vec2 pos, Vec2 vel, int n) {  // inertia_n_step_point with the ball's decay
+  return pos + vel * ((1.0 - agent2d::ball_decay_pow(n)) / (1.0 - kBallDecay));
+}
+
+// ServerParam::ballMoveStep: cycles for a ball at this speed to cover the distance.
+int ball_move_step(double speed, double dist) {
+  double n = -1.0;  // calc_length_geom_series
+  if (speed > 1.0e-6 && dist >= 0.0) {
+    const double tmp = 1.0 + dist * (kBallDecay - 1.0) / speed;
+    n = dist <= 1.0e-6 ? 0.0 : (tmp <= 1.0e-6 ? -1.0 : std::log(tmp) / std::log(kBallDecay));
+  }
+  return static_cast<int>(std::ceil(n) + 1.0e-10);
+}
+
+// FieldAnalyzer::predict_player_turn_cycle (back dashes allowed).
+int player_turn_cycles(double body_deg, double speed, double target_dist, double target_deg, double dist_thr) {
+  double angle_diff = std::fabs(angle_norm(target_deg - body_deg));
+  if (target_dist < 5.0 && angle_diff > 90.0 && kMinDashPower < -kMaxDashPower + 1.0) {
+    angle_diff = std::fabs(angle_diff - 180.0);
+  }
+  double turn_margin = 180.0;
+  if (dist_thr < target_dist) {
+    turn_margin = std::max(15.0, std::asin(dist_thr / target_dist) * kRadToDeg);
+  }
+  int n_turn = 0;
+  while (angle_diff > turn_margin) {
+    angle_diff -= kMaxMoment / (1.0 + kInertiaMoment * speed);
+    speed *= kPlayerDecay;
+    ++n_turn;
+  }
+  return n_turn;
+}
+
+// TackleGenerator::predictOpponentReachStep, with full state (no position or body count).
+int opponent_reach_step(const agent2d::PlayerView& o, Vec2 ball_pos, Vec2 ball_vel, double move_deg, int max_cycle) {
+  const double speed = o.vel.r();
+  // FieldAnalyzer::estimate_min_reach_cycle.
+  const Vec2 d = o.pos - ball_pos;
+  const double a = -move_deg * kDegToRad;
+  const Vec2 rel{d.x * std::cos(a) - d.y * std::sin(a), d.x * std::sin(a) + d.y * std::cos(a)};
+  int min_cycle =
+      rel.x < -1.0 ? -1 : std::max(1, static_cast<int>(std::floor(std::fabs(rel.y) / agent2d::kRealSpeedMax)));
+  if (min_cycle < 0) {
+    min_cycle = 10;
+  }
+  for (int cycle = min_cycle; cycle < max_cycle; ++cycle) {
+    const Vec2 ball = ball_after(ball_pos, ball_vel, cycle);
+    if (out_of_pitch(ball)) {
+      return 1000;
+    }
+    const Vec2 inertia = o.pos + o.vel * ((1.0 - std::pow(kPlayerDecay, cycle)) / (1.0 - kPlayerDecay));
+    const double target_dist = (ball - inertia).r();
+    if (target_dist - kKickableArea < 0.001) {
+      return cycle;
+    }
+    double dash_dist = target_dist;
+    if (cycle > 1) {
+      dash_dist -= kKickableArea + 0.5;
+    }
+    if (dash_dist > agent2d::kRealSpeedMax * cycle) {
+      continue;
+    }
+    const int n_dash = agent2d::cycles_to_reach_distance(dash_dist);
+    if (n_dash > cycle) {
+      continue;
+    }
+    const int n_turn = player_turn_cycles(o.body_deg, speed, target_dist, th_deg(ball - inertia), kKickableArea);
+    int n_step = n_turn == 0 ? n_dash : n_turn + n_dash + 1;
+    if (o.tackling) {
+      n_step += 5;
+    }
+    if (n_step <= cycle) {
+      return cycle;
+    }
+  }
+  return 1000;
+}
+
+// TackleGenerator::predictOpponentsReachStep.
+int opponents_reach_step(const GoalieWorld& w, Vec2 ball_vel, double move_deg) {
+  int first_min_step = 50;
+  if (out_of_pitch(w.ball_pos + ball_vel * (1.0 / (1.0 - kBallDecay)))) {
+    Vec2 sol;
+    const auto ahead = [&](Vec2 p) { return std::fabs(angle_norm(th_deg(p - w.ball_pos) - move_deg)) < 1.0; };
+    if (pitch_intersections(Line::from(w.ball_pos, move_deg), ahead, &sol) == 1) {
+      first_min_step = ball_move_step(ball_vel.r(), (sol - w.ball_pos).r());
+    }
+  }
+  int min_step = first_min_step;
+  for (int i = 0; i < w.num_opponents; ++i) {
+    min_step = std::min(min_step, opponent_reach_step(w.opponents[i], w.ball_pos, ball_vel, move_deg, min_step));
+  }
+  return min_step == first_min_step ? 1000 : min_step;
+}
+
+// TackleGenerator::evaluate: the score of a tackle that leaves the ball with velocity `vel`.
+double tackle_score(const GoalieWorld& w, Vec2 vel) {
+  const Vec2 end = w.ball_pos + vel * (1.0 / (1.0 - kBallDecay));  // inertia_final_point
+  const Segment ball_line{w.ball_pos, end};
+  const double speed = vel.r();
+  const double move_deg = th_deg(vel);
+  const double half_max = kBallSpeedMax * 0.5;
+  if (end.x > kPitchHalfLength && (w.ball_pos - Vec2{kPitchHalfLength, 0.0}).r2() < 20.0 * 20.0) {
+    const Vec2 p = ball_line.intersection(Line::through({kPitchHalfLength, 10.0}, {kPitchHalfLength, -10.0}));
+    if (valid(p) && std::fabs(p.y) < kGoalHalfWidth) {
+      constexpr double kGoalWidth = 2.0 * kGoalHalfWidth;
+      return 1000000.0 * (1.0 - std::exp(-speed * speed / (2.0 * half_max * half_max))) *
+             std::exp(-p.y * p.y / (2.0 * kGoalWidth * kGoalWidth));
+    }
+  }
+  if (end.x < -kPitchHalfLength) {
+    const Vec2 p = ball_line.intersection(Line::through({-kPitchHalfLength, 10.0}, {-kPitchHalfLength, -10.0}));
+    if (valid(p) && std::fabs(p.y) < kGoalHalfWidth + 1.0) {
+      const double dy = std::fabs(p.y) - kGoalHalfWidth;
+      return -10000.0 * std::exp(-dy * dy / (2.0 * kGoalHalfWidth * kGoalHalfWidth)) +
+             10000.0 * std::exp(-speed * speed / (2.0 * half_max * half_max));
+    }
+  }
+  const int opp_step = opponents_reach_step(w, vel, move_deg);
+  Vec2 final_point = ball_after(w.ball_pos, vel, opp_step);
+  {
+    const Segment seg{w.ball_pos, final_point};
+    Vec2 sol;
+    if (pitch_intersections(
+            Line::through(seg.origin, seg.terminal), [&](Vec2 p) { return seg.contains(p); }, &sol) > 0) {
+      final_point = sol;
+    }
+  }
+  const double goal_diff = std::fabs(angle_norm(th_deg(Vec2{-kPitchHalfLength, 0.0} - w.ball_pos) - move_deg));
+  const double goal_rate = 1.0 - std::exp(-goal_diff * goal_diff / (2.0 * 40.0 * 40.0));
+  const double y_off = std::fabs(final_point.y) - kPitchHalfWidth;
+  const double y_rate = std::fabs(final_point.y) > kPitchHalfWidth - 0.1
+                            ? 1.0
+                            : std::exp(-y_off * y_off / (2.0 * std::pow(kPitchHalfWidth * 0.7, 2)));
+  const double opp = static_cast<double>(opp_step);
+  const double opp_rate = 1.0 - std::exp(-opp * opp / (2.0 * 30.0 * 30.0));
+  return 10000.0 * goal_rate * y_rate * opp_rate;
+}
+
+// TackleGenerator::calculate: 40 directions from -180 degrees in 9-degree steps relative to the
+// body; the global direction of the best (the first of equal scores).
+double best_tackle_angle(const GoalieWorld& w) {
+  constexpr int kAngleDivs = 40;
+  constexpr double kStep = (kMaxMoment - kMinMoment) / kAngleDivs;
+  const double ball_rel = std::fabs(angle_norm(w.ball_angle_from_self_deg - w.self.body_deg));
+  const double tackle_rate = kTacklePowerRate * (1.0 - 0.5 * ball_rel / 180.0);
+  double best_angle = 0.0;  // TackleResult::clear
+  double best_score = -DBL_MAX;
+  for (int i = 0; i < kAngleDivs; ++i) {
+    const double dir = angle_norm(kMinMoment + kStep * i);
+    const double eff =
+        (kMaxBackTacklePower + (kMaxTacklePower - kMaxBackTacklePower) * (1.0 - std::fabs(dir) / 180.0)) * tackle_rate;
+    const double angle = angle_norm(w.self.body_deg + dir);
+    Vec2 vel = w.ball_vel + polar(eff, angle * kDegToRad);
+    if (const double v = vel.r(); v > kBallSpeedMax) {
+      vel *= kBallSpeedMax / v;
+    }
+    const double score = tackle_score(w, vel);
+    if (score > best_score) {
+      best_score = score;
+      best_angle = angle;
+    }
+  }
+  return best_angle;
+}
+
 bool basic_tackle(const Context& c) {
   const GoalieWorld& w = c.w;
   // In its own penalty area the goalie has no foul option (version 14 rule of
@@ -332,39 +562,9 @@ bool basic_tackle(const Context& c) {
          std::fabs(angle_norm(th_deg(their_goal - w.self.pos) - w.self.body_deg)) < 45.0))) {
     return false;
   }
-  // Bhv_BasicTackle::executeV14 without a foul: the tackle direction whose resulting ball
-  // velocity points farthest from its own goal among the forward ones (10-degree steps).
-  const double ball_rel = std::fabs(angle_norm(w.ball_angle_from_self_deg - w.self.body_deg));
-  const double tackle_rate = kTacklePowerRate * (1.0 - 0.5 * ball_rel / 180.0);
-  const Vec2 our_goal{-kPitchHalfLength, 0.0};
-  Vec2 virtual_accel{};
-  if (w.exist_kickable_opponent) {
-    const Vec2 d = our_goal - w.ball_pos;
-    virtual_accel = d * (0.5 / d.r());
-  }
-  double best_angle = 0.0;
-  double best_speed = -1.0;
-  for (double a = -180.0; a < 180.0; a += 10.0) {
-    const double rel = angle_norm(a - w.self.body_deg);
-    double eff = kMaxBackTacklePower + (kMaxTacklePower - kMaxBackTacklePower) * (1.0 - std::fabs(rel) / 180.0);
-    eff *= tackle_rate;
-    Vec2 vel = w.ball_vel + polar(eff, a * kDegToRad) + virtual_accel;
-    const double speed = vel.r();
-    if (speed > kBallSpeedMax) {
-      vel *= kBallSpeedMax / speed;
-    }
-    if (std::fabs(th_deg(vel)) > 90.0) {
-      continue;
-    }
-    if (vel.r() > best_speed) {
-      best_speed = vel.r();
-      best_angle = a;
-    }
-  }
-  if (best_speed < 0.0) {
-    return false;
-  }
-  *c.out = {Command::Kind::kTackle, angle_norm(best_angle - w.self.body_deg), 0.0};
+  // Bhv_BasicTackle::executeV14 without a foul: always a tackle, in TackleGenerator's best
+  // direction.
+  *c.out = {Command::Kind::kTackle, angle_norm(best_tackle_angle(w) - w.self.body_deg), 0.0};
   return true;
 }
 
