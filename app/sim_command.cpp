@@ -111,9 +111,10 @@ void register_sim(CLI::App& app) {
       "replay an action script from a given state and print step,status,reward,f0..f57 as CSV (with --goalie: "
       "f0..f65, then the goalie's command and state g_cmd,g_p1,g_p2,g_x,g_y,g_vx,g_vy,g_body)");
   trace
-      ->add_option("--init", opts->init,
-                   "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}, "
-                   "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch}}")
+      ->add_option(
+          "--init", opts->init,
+          "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}, "
+          "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch, tackle_cycles, caught}}")
       ->required()
       ->check(CLI::ExistingFile);
   trace

@@ -346,6 +346,55 @@ TEST(Cli, SimTraceSetsAndReportsTheGoalie) {
   EXPECT_NEAR(std::stod(b[g + 7]), 156.152, 1e-2);
 }
 
+// The goalie's memory keys: the same state with the goalie still frozen for 2 cycles by its
+// own tackle sends no body command for two steps (the server would refuse it), and after its
+// own catch ("caught") it does not catch again: it keeps its position.
+TEST(Cli, SimTraceTakesTheGoaliesMemory) {
+  const auto trace = [](const std::string& ball, const std::string& goalie) {
+    const TempFile state(".json", R"({"agent": {"x": 40.745, "y": 7.0847, "body_deg": -11.456}, "ball": )" + ball +
+                                      R"(, "goalie": )" + goalie + "}");
+    const TempFile actions(".csv", "DASH,100,0\nDASH,100,0\nDASH,100,0\n");
+    const RunResult r = run_pamdp(
+        "sim trace --no-noise --goalie --init " + quoted(state.path()) + " --actions " + quoted(actions.path()),
+        Capture::kStdoutOnly);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::vector<std::string> commands;
+    std::istringstream in(r.output);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      std::string c;
+      while (std::getline(ss, c, ',')) {
+        cells.push_back(c);
+      }
+      commands.push_back(cells.size() > 69 ? cells[69] : "");
+    }
+    return commands;
+  };
+  // A ball rolling slowly toward a goalie 5 m away, which would move at once.
+  const std::string slow = R"({"x": 45, "y": 0, "vx": 0.5, "vy": 0})";
+  const std::vector<std::string> free = trace(slow, R"({"x": 50, "y": 2, "body_deg": 180})");
+  const std::vector<std::string> frozen = trace(slow, R"({"x": 50, "y": 2, "body_deg": 180, "tackle_cycles": 2})");
+  ASSERT_EQ(free.size(), 4U);
+  ASSERT_EQ(frozen.size(), 4U);
+  EXPECT_NE(free[1], "NONE");
+  EXPECT_EQ(frozen[1], "NONE");
+  EXPECT_EQ(frozen[2], "NONE");
+  EXPECT_NE(frozen[3], "NONE");
+  // Row 3 of the real goalie transitions (above): it catches, unless it caught already.
+  const std::string shot = R"({"x": 48.9381, "y": 5.9098, "vx": 1.9668, "vy": -0.276})";
+  const std::string keeper = R"({"x": 49.9714, "y": 5.453, "vy": 0.1344, "body_deg": 90)";
+  const std::vector<std::string> catches = trace(shot, keeper + "}");
+  const std::vector<std::string> caught = trace(shot, keeper + R"(, "caught": true})");
+  ASSERT_GE(catches.size(), 2U);
+  ASSERT_GE(caught.size(), 2U);
+  EXPECT_EQ(catches[1], "CATCH");
+  EXPECT_NE(caught[1], "CATCH");
+  EXPECT_NE(caught[1], "NONE");
+}
+
 // Test names and failure messages show the case's name, not its bytes.
 void PrintTo(const BadInvocation& c, std::ostream* os) {
   *os << c.name;
@@ -489,6 +538,15 @@ INSTANTIATE_TEST_SUITE_P(
                        true,
                        "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"z\": 0}}",
                        {"goalie.z"}},
+        MalformedInput{
+            "StateGoalieFrozenTooLong",
+            true,
+            "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"tackle_cycles\": 11}}",
+            {"goalie.tackle_cycles", "[0, 10]"}},
+        MalformedInput{"StateGoalieCaughtNotABoolean",
+                       true,
+                       "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"caught\": 1}}",
+                       {"goalie.caught"}},
         MalformedInput{"StateGoalieWithoutGoalieFlag",
                        true,
                        "{\"agent\": {\"x\": 1, \"y\": 2}, \"ball\": {\"x\": 3, \"y\": 4}, \"goalie\": {\"x\": 50}}",

@@ -114,7 +114,7 @@ SoccerSim sim_at(const CsvRow& r, bool goalie_plays, const Memory& m = {}) {
     s.num_players = kGoalieIndex + 1;
   }
   sim.mutable_state().players[kGoalieIndex].tackle_cycles = m.tackle_cycles;
-  sim.mutable_state().ball_caught = m.ball_caught;
+  sim.mutable_state().players[kGoalieIndex].caught = m.ball_caught;
   return sim;
 }
 

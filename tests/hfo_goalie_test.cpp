@@ -111,14 +111,14 @@ TEST(HfoGoalie, TackleFreezeAndCatchMemoryCarryOverTheReset) {
   PlayerState g = sim.state().players[kGoalieIndex];
   g.tackle_cycles = 6;
   g.since_catch = 2;
+  g.caught = true;
   sim.set_goalie(g);
-  sim.mutable_state().ball_caught = true;
   sim.reset_episode();
   const PlayerState& after = sim.state().players[kGoalieIndex];
   // One cycle the server waits after the terminal state, then the two before the observation.
   EXPECT_EQ(after.tackle_cycles, 6 - 1 - kCyclesBeforeFirstObservation);
   EXPECT_EQ(after.since_catch, 2 + 1 + kCyclesBeforeFirstObservation);
-  EXPECT_FALSE(sim.state().ball_caught) << "the reset's play_on ends the goalie's catch play mode";
+  EXPECT_FALSE(after.caught) << "the reset's play_on ends the goalie's catch play mode";
   EXPECT_EQ(after.pos.x, kGoalieStart.x) << "frozen: it could not move in the first two cycles";
   EXPECT_EQ(after.pos.y, kGoalieStart.y);
 }
@@ -219,7 +219,7 @@ TEST(HfoGoalie, CaughtBallFliesOnInHfoMode) {
   ASSERT_EQ(c.kind, GoalieCommand::Kind::kCatch);
   EXPECT_NEAR(c.p1, 88.7726, 1e-2);  // the logged state is rounded to 1e-4
   EXPECT_EQ(sim.step(), kInGame);
-  EXPECT_TRUE(sim.state().ball_caught) << "it heard goalie_catch_ball_r: the set play's move until the reset";
+  EXPECT_TRUE(sim.state().players[kGoalieIndex].caught) << "it heard goalie_catch_ball_r: the set play until the reset";
   const PlayerState& after = sim.state().players[kGoalieIndex];
   EXPECT_NEAR(after.pos.x, 49.2903, 2e-4);
   EXPECT_NEAR(after.pos.y, 5.7541, 2e-4);

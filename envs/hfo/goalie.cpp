@@ -736,7 +736,7 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_
   w.ball_pos = mirror(s.ball.pos);
   w.ball_vel = mirror(s.ball.vel);
   w.since_catch = me.since_catch;
-  w.catch_mode = s.ball_caught;
+  w.catch_mode = me.caught;
   w.player_rand = server_noise ? kPlayerRand : 0.0;
   w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {

@@ -5,8 +5,8 @@
 // (tests/hfo_goalie_real_data_test.cpp, docs/simulator.md).
 //
 // decide_goalie() is a pure function of the state at the start of a cycle plus the memory the
-// real goalie keeps, which lives in the state (PlayerState::since_catch, and
-// SoccerState::ball_caught for the play mode it believes in after a catch). It returns the
+// real goalie keeps, which lives in the state (PlayerState::since_catch, and PlayerState::caught
+// for the play mode it believes in after a catch). It returns the
 // command the goalie's client sends to the server, in the server's units (dash power and
 // direction after librcsc's client adjustments, turn moment, catch direction relative to the
 // body), which SoccerSim then executes with the server's handling. It draws no random numbers

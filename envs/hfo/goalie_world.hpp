@@ -94,7 +94,7 @@ struct GoalieWorld {
   // server send every player the referee's goalie_catch_ball_r (Stadium::ballCaught); in HFO
   // mode the play mode itself stays play_on (CatchRef::ballCaught returns at once) and the
   // next play-mode message is the reset's before_kick_off / play_on (HFORef::analyse). Until
-  // then the goalie plays the set play: Bhv_SetPlay -> Bhv_GoalieFreeKick.
+  // then the goalie plays the set play: Bhv_SetPlay -> Bhv_GoalieFreeKick (PlayerState::caught).
   bool catch_mode = false;
   // The server's noise parameters, which librcsc reads from the server and builds into its
   // intercept margins (player_rand, ball_rand): 0.1 and 0.05 by default, 0 with noise off.

@@ -366,6 +366,7 @@ bool SoccerSim::goalie_catch(int player, double dir_deg) {
   player_accel_[player] = {};
   collide_objects();
   state_.ball_caught = true;
+  p.caught = true;
   return true;
 }
 

@@ -87,6 +87,9 @@ struct PlayerState {
   // kNoCatchYet when it has not sent one this episode.
   int since_catch = kNoCatchYet;
   static constexpr int kNoCatchYet = 1000;
+  // Goalie's own memory: it caught the ball this episode and heard the referee's
+  // goalie_catch_ball, so it plays the set play until the reset (goalie_world.hpp, catch_mode).
+  bool caught = false;
   bool collided_ball = false;
   bool collided_player = false;
   bool collided_post = false;

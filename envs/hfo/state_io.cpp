@@ -86,7 +86,8 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
     if (!g.is_object()) {
       throw std::runtime_error(src + ": \"goalie\" must be an object");
     }
-    reject_unknown(g, "goalie", {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch"}, src);
+    reject_unknown(g, "goalie", {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch", "tackle_cycles", "caught"},
+                   src);
     s.has_goalie = true;
     s.goalie.pos = {number(g, "goalie", "x", src, kGoalieStart.x), number(g, "goalie", "y", src, kGoalieStart.y)};
     s.goalie.vel = {number(g, "goalie", "vx", src, 0.0), number(g, "goalie", "vy", src, 0.0)};
@@ -100,6 +101,18 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       throw std::runtime_error(src + ": goalie.since_catch must be a whole number of cycles >= 0");
     }
     s.goalie.since_catch = static_cast<int>(std::min(since, static_cast<double>(PlayerState::kNoCatchYet)));
+    const double frozen = number(g, "goalie", "tackle_cycles", src, 0.0);
+    if (frozen < 0.0 || frozen > kTackleCycles || frozen != std::floor(frozen)) {
+      throw std::runtime_error(src + ": goalie.tackle_cycles must be a whole number of cycles within [0, " +
+                               std::to_string(kTackleCycles) + "]");
+    }
+    s.goalie.tackle_cycles = static_cast<int>(frozen);
+    if (g.contains("caught")) {
+      if (!g["caught"].is_boolean()) {
+        throw std::runtime_error(src + ": goalie.caught must be true or false");
+      }
+      s.goalie.caught = g["caught"].get<bool>();
+    }
   }
   return s;
 }

@@ -1,10 +1,13 @@
 // Reading states and action scripts for `pamdp sim trace` and tests.
 //
 // STATE.json: {"agent": {"x", "y", "vx", "vy", "body_deg", "stamina"}, "ball": {"x", "y", "vx", "vy"},
-//              "goalie": {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch"}}
+//              "goalie": {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch", "tackle_cycles",
+//                         "caught"}}
 // (velocities are the observed, post-decay ones; stamina defaults to 8000, velocities to 0).
 // "goalie" is optional; each of its keys missing takes its value at a reset (52.5, 0, at rest,
-// body 180, stamina 8000, no catch yet); since_catch counts the cycles since its last catch.
+// body 180, stamina 8000, no catch yet, not frozen); since_catch counts the cycles since its last
+// catch command, tackle_cycles the cycles its own tackle still freezes it (0-10), and caught says
+// it caught the ball earlier in the episode (it then only keeps its position until the reset).
 // ACTIONS.csv: one action per row: DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir;
 // blank lines and lines starting with '#' are skipped.
 // Both throw std::runtime_error naming the file, line and problem.
