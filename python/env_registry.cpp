@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "app/env_factory.hpp"
-#include "envs/toy/reach_stop.hpp"
+#include "envs/registry.hpp"
 
 namespace pamdp::python {
 namespace {
@@ -115,8 +115,12 @@ std::unique_ptr<Env> build_env(const app::EnvConfig& config) {
 }
 
 std::string id_of(const app::EnvConfig& config) {
-  if (config.name == "hfo") {
-    return config.hfo.goalie ? "hfo-1v1" : "hfo-1v0";
+  // The goalie picks between the ids that name env 'hfo' with the goalie fixed.
+  const std::string fixed = config.params.boolean("goalie") ? "goalie=true" : "goalie=false";
+  for (const Entry& e : entries()) {
+    if (e.name == config.name && e.fixed.size() == 1 && e.fixed.front() == fixed) {
+      return e.id.id;
+    }
   }
   return config.name;
 }
@@ -128,12 +132,11 @@ std::string env_toml(const app::EnvConfig& config) {
 }
 
 bool fresh_env_per_seed(const app::EnvConfig& config) {
-  return config.name != "hfo-server";
+  return !env_registry().find(config.name).location;
 }
 
 float observation_bound(const app::EnvConfig& config) {
-  // HFO's features are normalized to [-1, 1] (hfo-reference.md §3); the toy task states its own.
-  return config.name == "reach_stop" ? toy::ReachStopEnv::kObservationBound : 1.0F;
+  return env_registry().find(config.name).observation_bound;
 }
 
 }  // namespace pamdp::python
