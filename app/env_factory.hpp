@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "app/experiment_config.hpp"
 #include "envs/env.hpp"
@@ -31,6 +32,15 @@ inline std::unique_ptr<Env> make_eval_env(const ExperimentConfig& c) {
     return r.make(c.env.params);
   }
   return r.make(r.eval_params(c.env.params, c.train.eval_episodes > 0));
+}
+
+// The registered envs with their descriptions, for the --help of the commands that take env.name.
+inline std::string env_help_footer() {
+  std::string out = "Envs (env.name):";
+  for (const EnvRegistration& r : env_registry().all()) {
+    out += "\n  " + r.name + std::string(r.name.size() < 12 ? 12 - r.name.size() : 1, ' ') + r.description;
+  }
+  return out;
 }
 
 // Resolves action names ("TACKLE") and parameter ranges by name against the env's space.

@@ -339,6 +339,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
 void register_eval(CLI::App& app) {
   auto opts = std::make_shared<EvalOptions>();
   CLI::App* cmd = app.add_subcommand("eval", "play N episodes with a policy and print the paper's table row");
+  cmd->footer(env_help_footer());
   cmd->add_option("--policy", opts->policy, "scripted (hand-coded offense) or random")
       ->check(CLI::IsMember({"scripted", "random"}))
       ->capture_default_str();
