@@ -16,31 +16,36 @@ struct Entry {
   std::vector<std::string> options;  // the env.* keys a user may set
 };
 
-const std::vector<std::string> kHfoOptions{"body_at_reset", "goalie", "max_steps",      "noise",
-                                           "referee",       "start",  "untouched_limit"};
-const std::vector<std::string> kHfoFixedGoalie{"body_at_reset", "max_steps", "noise",
-                                               "referee",       "start",     "untouched_limit"};
-// The keys server_config() in app/env_factory.hpp reads.
-const std::vector<std::string> kServerOptions{"goalie",      "max_steps",   "server_config_dir", "server_encoding",
-                                              "server_host", "server_port", "server_team"};
+// The keys env `name` reads (envs/registry.hpp), less `fixed_key`.
+std::vector<std::string> options_of(const std::string& name, const std::string& fixed_key = "") {
+  std::vector<std::string> out;
+  for (const EnvKey& k : env_registry().find(name).keys) {
+    if (k.name != fixed_key) {
+      out.push_back(k.name);
+    }
+  }
+  return out;
+}
 
+// The two HFO set-ups by id, then every registered env by its name, so that a new env is offered
+// here without a line in this file.
 const std::vector<Entry>& entries() {
-  static const std::vector<Entry> kEntries{
-      {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
-       "hfo",
-       {"goalie=false"},
-       kHfoFixedGoalie},
-      {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
-       "hfo",
-       {"goalie=true"},
-       kHfoFixedGoalie},
-      {{"hfo", "embedded Half Field Offense, goalie chosen by the goalie option"}, "hfo", {}, kHfoOptions},
-      {{"reach_stop", "toy task: reach the target on a line, then STOP (3 features)"}, "reach_stop", {}, {}},
-      {{"hfo-server", "the real HFO server through its C++ client (a build with -DHFO_ROOT)"},
-       "hfo-server",
-       {},
-       kServerOptions},
-  };
+  static const std::vector<Entry> kEntries = [] {
+    std::vector<Entry> e{
+        {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
+         "hfo",
+         {"goalie=false"},
+         options_of("hfo", "goalie")},
+        {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
+         "hfo",
+         {"goalie=true"},
+         options_of("hfo", "goalie")},
+    };
+    for (const EnvRegistration& r : env_registry().all()) {
+      e.push_back({{r.name, r.description}, r.name, {}, options_of(r.name)});
+    }
+    return e;
+  }();
   return kEntries;
 }
 
