@@ -416,6 +416,23 @@ void apply_override(toml::table& root, const std::string& assignment) {
   t->insert_or_assign(parts.back(), *parsed.get("v"));
 }
 
+// The registered envs that give the embedded HFO features, and the setting that makes them
+// ("env.name = \"hfo\" or env.name = \"hfo-server\" with env.server_encoding = embedded").
+std::string envs_giving_embedded_features() {
+  std::string out;
+  for (const EnvRegistration& r : env_registry().all()) {
+    EnvParams p = env_registry().defaults();
+    std::string with;
+    if (r.use_embedded_hfo_features) {
+      with = " with " + r.use_embedded_hfo_features(p);
+    }
+    if (r.gives_embedded_hfo_features && r.gives_embedded_hfo_features(p)) {
+      out += (out.empty() ? "" : " or ") + ("env.name = \"" + r.name + "\"") + with;
+    }
+  }
+  return out;
+}
+
 void validate(const ExperimentConfig& c, const std::string& src) {
   if (c.exploration.epsilon_end > c.exploration.epsilon_start) {
     throw std::runtime_error(src + ": exploration.epsilon_end must not exceed exploration.epsilon_start");
@@ -429,8 +446,8 @@ void validate(const ExperimentConfig& c, const std::string& src) {
   if (c.exploration.demo_fraction > 0.0 && !gives_embedded_features(c.env)) {
     throw std::runtime_error(src +
                              ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
-                             "HFO features: use env.name = \"hfo\" (or hfo-server with env.server_encoding = "
-                             "\"embedded\"), or set exploration.demo_fraction = 0");
+                             "HFO features: use " +
+                             envs_giving_embedded_features() + ", or set exploration.demo_fraction = 0");
   }
   if (c.ddpg.demo_bc_weight > 0.0 && c.exploration.demo_fraction <= 0.0) {
     throw std::runtime_error(src +
