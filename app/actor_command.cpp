@@ -21,6 +21,7 @@
 #include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
+#include "envs/registry.hpp"
 
 namespace pamdp::app {
 namespace {
@@ -98,15 +99,15 @@ void run_actor(const ActorCliOptions& o) {
   ExperimentConfig config = parse_experiment_config(map->config_toml, "the cluster map from " + o.join, {});
   // Every actor has an HFO server of its own; the cluster's config names one port for all.
   if (!o.server_host.empty()) {
-    config.env.server_host = o.server_host;
+    config.env.params.set("server_host", o.server_host);
   }
   if (o.server_port > 0) {
-    config.env.server_port = o.server_port;
+    config.env.params.set("server_port", int64_t{o.server_port});
   }
-  if (config.env.name == "hfo-server" && o.envs > 1) {
-    throw std::runtime_error("--envs " + std::to_string(o.envs) +
-                             ": env 'hfo-server' plays one HFO server per actor; start one actor per server, each "
-                             "with --envs 1 --server-port PORT");
+  const EnvRegistration& registration = env_registry().find(config.env.name);
+  if (registration.max_per_process > 0 && o.envs > registration.max_per_process) {
+    throw std::runtime_error("--envs " + std::to_string(o.envs) + ": env '" + config.env.name + "' " +
+                             registration.max_per_process_note);
   }
 
   std::vector<std::unique_ptr<Env>> envs;
@@ -151,9 +152,7 @@ void run_actor(const ActorCliOptions& o) {
     last = now;
     last_steps = steps;
   };
-  const std::string server = config.env.name == "hfo-server"
-                                 ? " at " + config.env.server_host + ":" + std::to_string(config.env.server_port)
-                                 : std::string();
+  const std::string server = registration.location ? registration.location(config.env.params) : std::string();
   std::printf("pamdp actor: actor %u, %d %s env(s)%s, %zu shard(s), learner %s\n", loop.actor_index(), o.envs,
               config.env.name.c_str(), server.c_str(), map->shard_endpoints.size(), o.join.c_str());
   std::fflush(stdout);

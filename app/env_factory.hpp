@@ -1,67 +1,46 @@
-// Builds the env an experiment config names.
+// Builds the env an experiment config names, through the env registry (envs/registry.hpp).
 #pragma once
 
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "app/experiment_config.hpp"
 #include "envs/env.hpp"
-#include "envs/hfo/hfo_env.hpp"
-#include "envs/hfo_server/hfo_server_env.hpp"
-#include "envs/toy/reach_stop.hpp"
+#include "envs/registry.hpp"
 
 namespace pamdp::app {
 
-// The settings of the real-server env (env.name = "hfo-server") that `c` describes.
-inline hfo_server::HfoServerConfig server_config(const EnvConfig& c) {
-  hfo_server::HfoServerConfig s;
-  s.host = c.server_host;
-  s.port = c.server_port;
-  s.encoding = c.server_encoding;
-  s.team = c.server_team;
-  s.config_dir = c.server_config_dir;
-  s.opponents = c.hfo.goalie ? 1 : 0;
-  s.max_steps = c.hfo.max_steps;
-  s.connect_timeout_s = c.server_connect_timeout_s;
-  return s;
-}
-
-// Throws for a name this build cannot make (hfo-server without -DHFO_ROOT: the fix). An
-// hfo-server env connects on its first reset(), so making one only to learn its sizes is free.
+// Throws for a name that is not registered (listing those that are) and for an env this build
+// cannot make (hfo-server without -DHFO_ROOT: the fix).
 inline std::unique_ptr<Env> make_env(const EnvConfig& c) {
-  if (c.name == "hfo") {
-    return std::make_unique<hfo::HfoEnv>(c.hfo);
-  }
-  if (c.name == "reach_stop") {
-    return std::make_unique<toy::ReachStopEnv>();
-  }
-  if (c.name == "hfo-server") {
-    return hfo_server::make_hfo_server_env(server_config(c));
-  }
-  throw std::runtime_error("env.name '" + c.name + "' is unknown (valid: hfo, reach_stop, hfo-server)");
+  return env_registry().find(c.name).make(c.params);
 }
 
-// The observation width of the env `c` describes, also for an hfo-server env in a build without
-// HFO (a checkpoint trained on the real server can still be inspected there).
+// The observation width of the env `c` describes, without making it (a checkpoint trained on the
+// real server can still be inspected in a build without HFO).
 inline int observation_size(const EnvConfig& c) {
-  return c.name == "hfo-server" ? hfo_server::observation_size(server_config(c)) : make_env(c)->observation_size();
+  return env_registry().find(c.name).observation_size(c.params);
 }
 
-// The env of the greedy evaluations `pamdp train` and `pamdp learner` run beside acting. On the
-// real server it needs a server of its own (env.server_eval_port), demanded only when
-// evaluations are on (train.eval_episodes > 0).
+// The env of the greedy evaluations `pamdp train` and `pamdp learner` run beside acting; an env
+// may need settings of its own for them (hfo-server: a server of its own, env.server_eval_port),
+// demanded only when evaluations are on (train.eval_episodes > 0).
 inline std::unique_ptr<Env> make_eval_env(const ExperimentConfig& c) {
-  if (c.env.name != "hfo-server" || c.train.eval_episodes == 0) {
-    return make_env(c.env);
+  const EnvRegistration& r = env_registry().find(c.env.name);
+  if (!r.eval_params) {
+    return r.make(c.env.params);
   }
-  if (c.env.server_eval_port == 0 || c.env.server_eval_port == c.env.server_port) {
-    throw std::runtime_error(
-        "greedy evaluations on env 'hfo-server' (train.eval_episodes > 0) need an HFO server of their own: start "
-        "one and set env.server_eval_port to its port, or set train.eval_episodes=0");
+  return r.make(r.eval_params(c.env.params, c.train.eval_episodes > 0));
+}
+
+// The registered envs with their descriptions, for the --help of the commands that take env.name.
+inline std::string env_help_footer() {
+  std::string out = "Envs (env.name):";
+  for (const EnvRegistration& r : env_registry().all()) {
+    out += "\n  " + r.name + std::string(r.name.size() < 12 ? 12 - r.name.size() : 1, ' ') + r.description;
   }
-  EnvConfig e = c.env;
-  e.server_port = c.env.server_eval_port;
-  return make_env(e);
+  return out;
 }
 
 // Resolves action names ("TACKLE") and parameter ranges by name against the env's space.
@@ -95,7 +74,9 @@ inline ExplorationConfig resolve_exploration(const ExperimentConfig& c, const Ac
         found = true;
       }
     }
-    if (!found && c.env.name == "hfo") {
+    // Names are checked on HFO's action space only: the default (dash_power) is HFO's, and other
+    // envs keep their own ranges.
+    if (!found && env_registry().find(c.env.name).hfo_actions) {
       throw std::runtime_error("exploration.random_param_ranges: '" + name + "' is not a parameter of env '" +
                                c.env.name + "'");
     }

@@ -21,6 +21,8 @@
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/settings.hpp"
+#include "envs/registry.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/evaluation.hpp"
 
@@ -178,13 +180,18 @@ EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, cons
   return r;
 }
 
-// Settings of the embedded simulator that the real server takes as its own flags instead.
-void refuse_sim_options_on_server(const CLI::App& cmd) {
-  for (const char* flag : {"--no-noise", "--start", "--referee", "--body-reset", "--untouched-limit"}) {
-    if (cmd.count(flag) > 0) {
-      throw std::runtime_error(std::string(flag) +
-                               " sets up the embedded simulator; the HFO server takes its own flags (bin/HFO "
-                               "--deterministic, --ball-x-min/--ball-x-max, --untouched-time; docs/hfo-server.md)");
+// The simulator flags set env.* keys; an env that does not read one (hfo-server: the server's own
+// flags set up its game) refuses the flag rather than ignoring it.
+void refuse_unread_sim_options(const CLI::App& cmd, const std::string& env) {
+  const std::pair<const char*, const char*> flags[] = {{"--no-noise", "noise"},
+                                                       {"--start", "start"},
+                                                       {"--referee", "referee"},
+                                                       {"--body-reset", "body_at_reset"},
+                                                       {"--untouched-limit", "untouched_limit"}};
+  for (const auto& [flag, key] : flags) {
+    if (cmd.count(flag) > 0 && !env_registry().reads(env, key)) {
+      throw std::runtime_error(std::string(flag) + " sets env." + key + ", which env '" + env +
+                               "' does not read: " + env_registry().find(env).description);
     }
   }
 }
@@ -211,35 +218,36 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   ExperimentConfig c = parse_experiment_config(read_checkpoint_config(o.checkpoint), o.checkpoint + " (config)", {});
   const int trained_width = observation_size(c.env);
   const std::string trained_env = c.env.name;
+  const bool trained_embedded = gives_embedded_features(c.env);
   if (!o.env.empty() && o.env != c.env.name) {
     c.env.name = o.env;
-    if (o.env == "hfo-server" && trained_env == "hfo") {
-      c.env.server_encoding = hfo_server::Encoding::kEmbedded;
+    const auto& use_embedded = env_registry().find(o.env).use_embedded_hfo_features;
+    if (trained_embedded && !gives_embedded_features(c.env) && use_embedded) {
+      const std::string changed = use_embedded(c.env.params);
       std::fprintf(stderr,
-                   "eval: %s was trained on the embedded simulator; the server's features are given to it in the "
-                   "embedded encoding (env.server_encoding = embedded)\n",
-                   o.checkpoint.c_str());
+                   "eval: %s was trained on the embedded simulator's features; env '%s' gives them to it (%s)\n",
+                   o.checkpoint.c_str(), o.env.c_str(), changed.c_str());
     }
   }
   c = with_env_overrides(c, o.sets);
-  if (c.env.name == "hfo-server") {
-    refuse_sim_options_on_server(cmd);
-  }
+  refuse_unread_sim_options(cmd, c.env.name);
   if (o.sim.no_noise) {
-    c.env.hfo.noise = false;
+    c.env.params.set("noise", false);
   }
-  if (o.sim.config.goalie && !c.env.hfo.goalie) {
+  if (o.sim.config.goalie && !c.env.params.boolean("goalie")) {
     throw std::runtime_error("--goalie: " + o.checkpoint +
                              " was trained without a goalie (env.goalie = false, 58 features); a checkpoint is "
                              "evaluated on its own env");
   }
   auto env = make_env(c.env);
   if (env->observation_size() != trained_width) {
+    const auto& use_embedded = env_registry().find(c.env.name).use_embedded_hfo_features;
+    EnvParams embedded = c.env.params;
     throw std::runtime_error(
         "--env " + c.env.name + ": " + o.checkpoint + " reads " + std::to_string(trained_width) +
         " features (trained on env '" + trained_env + "'), env '" + c.env.name + "' gives " +
         std::to_string(env->observation_size()) +
-        (c.env.name == "hfo-server" ? " (env.server_encoding = embedded gives the embedded width)" : std::string()));
+        (use_embedded ? " (" + use_embedded(embedded) + " gives the embedded width)" : std::string()));
   }
   Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
   load_checkpoint(o.checkpoint, ddpg);
@@ -287,25 +295,27 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   ExperimentConfig c;
   c.env.name = o.env.empty() ? "hfo" : o.env;
-  c.env.hfo = o.sim.resolved();
-  if (c.env.name == "hfo-server") {
-    refuse_sim_options_on_server(cmd);
-    if (o.policy == "scripted") {
-      c.env.server_encoding = hfo_server::Encoding::kEmbedded;  // it reads the embedded features
-    }
+  hfo::set_sim_config(c.env.params, o.sim.resolved());
+  const EnvRegistration& registration = env_registry().find(c.env.name);
+  refuse_unread_sim_options(cmd, c.env.name);
+  if (o.policy == "scripted" && registration.use_embedded_hfo_features) {
+    (void)registration.use_embedded_hfo_features(c.env.params);  // the scripted offense reads the embedded features
   }
   c = with_env_overrides(c, o.sets);
-  if (c.env.name != "hfo" && c.env.name != "hfo-server") {
+  if (!env_registry().find(c.env.name).hfo_actions) {
     throw std::runtime_error("--policy " + o.policy + " plays HFO; env '" + c.env.name + "' takes --checkpoint");
   }
-  if (o.policy == "scripted" && !gives_embedded_features(c.env)) {  // env.name is hfo or hfo-server here
-    throw std::runtime_error("--policy scripted reads the embedded encoding: leave env.server_encoding = embedded");
+  if (o.policy == "scripted" && !gives_embedded_features(c.env)) {
+    const auto& use_embedded = env_registry().find(c.env.name).use_embedded_hfo_features;
+    EnvParams embedded = c.env.params;
+    throw std::runtime_error("--policy scripted reads the embedded encoding" +
+                             (use_embedded ? ": leave " + use_embedded(embedded) : std::string()));
   }
   const bool shot_given = cmd.count("--shot") > 0;
   if (shot_given && o.policy != "scripted") {
     throw std::runtime_error("--shot aims the scripted offense's shots: use it with --policy scripted");
   }
-  if (shot_given && !c.env.hfo.goalie) {
+  if (shot_given && !c.env.params.boolean("goalie")) {
     throw std::runtime_error(
         "--shot aims the scripted offense's shots past a goalie; on the empty goal it shoots at the centre: add "
         "--goalie, or leave out --shot");
@@ -329,6 +339,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
 void register_eval(CLI::App& app) {
   auto opts = std::make_shared<EvalOptions>();
   CLI::App* cmd = app.add_subcommand("eval", "play N episodes with a policy and print the paper's table row");
+  cmd->footer(env_help_footer());
   cmd->add_option("--policy", opts->policy, "scripted (hand-coded offense) or random")
       ->check(CLI::IsMember({"scripted", "random"}))
       ->capture_default_str();
@@ -341,10 +352,10 @@ void register_eval(CLI::App& app) {
                   "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--env", opts->env,
-                  "play on this env instead (hfo, hfo-server: a running HFO server, docs/hfo-server.md; "
-                  "reach_stop with --checkpoint); a checkpoint trained on hfo gets the server's features in "
-                  "the embedded encoding")
-      ->check(CLI::IsMember({"hfo", "hfo-server", "reach_stop"}));
+                  "play on this env instead: " + env_registry().names_joined() +
+                      " (--policy plays envs with HFO's actions, others take --checkpoint); a checkpoint trained on "
+                      "the embedded simulator gets the embedded features where the env can give them")
+      ->check(CLI::IsMember(env_registry().names()));
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
   const std::map<std::string, ActorCopy> actors{

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "envs/hfo/settings.hpp"
+
 namespace pamdp::app {
 namespace {
 
@@ -27,26 +29,35 @@ std::vector<std::string> split_path(const std::string& key) {
   return parts;
 }
 
+// An env.* key as its env declares it (envs/registry.hpp).
+template <typename V>
+void visit_env_key(V& v, const EnvKey& k, EnvValue& value) {
+  const std::string key = "env." + k.name;
+  switch (k.type) {
+    case EnvKey::Type::kBoolean: v.boolean(key, std::get<bool>(value)); break;
+    case EnvKey::Type::kInteger: v.integer(key, std::get<int64_t>(value), k.lo, k.hi); break;
+    case EnvKey::Type::kText: v.text(key, std::get<std::string>(value)); break;
+    case EnvKey::Type::kTextOrEmpty: v.text_or_empty(key, std::get<std::string>(value)); break;
+    case EnvKey::Type::kChoice: {
+      Choices<std::string> choices;
+      for (const std::string& name : k.choices) {
+        choices.emplace_back(name, name);
+      }
+      v.choice(key, std::get<std::string>(value), choices);
+      break;
+    }
+  }
+}
+
 // Every field of the config is listed once, in visit(); the reader and the writer below are the
 // two visitors, so the file format and the struct cannot drift apart.
 template <typename V>
 void visit(V& v, ExperimentConfig& c) {
   v.integer("seed", c.seed, 0, INT64_MAX);
   v.choice("env.name", c.env.name, env_choices());
-  v.boolean("env.noise", c.env.hfo.noise);
-  v.choice("env.start", c.env.hfo.start, start_choices());
-  v.choice("env.referee", c.env.hfo.referee, referee_choices());
-  v.choice("env.body_at_reset", c.env.hfo.body_at_reset, body_at_reset_choices());
-  v.integer("env.max_steps", c.env.hfo.max_steps, 1, 1000000);
-  v.integer("env.untouched_limit", c.env.hfo.untouched_limit, 1, 1000000);
-  v.boolean("env.goalie", c.env.hfo.goalie);
-  v.text("env.server_host", c.env.server_host);
-  v.integer("env.server_port", c.env.server_port, 1, 65535);
-  v.integer("env.server_eval_port", c.env.server_eval_port, 0, 65535);
-  v.choice("env.server_encoding", c.env.server_encoding, server_encoding_choices());
-  v.text("env.server_team", c.env.server_team);
-  v.text_or_empty("env.server_config_dir", c.env.server_config_dir);
-  v.integer("env.server_connect_timeout_s", c.env.server_connect_timeout_s, 1, 3600);
+  for (const EnvKey& k : env_registry().keys()) {
+    visit_env_key(v, k, c.env.params.at(k.name));
+  }
 
   v.int_list("ddpg.hidden", c.ddpg.hidden, 1, 1 << 16);
   v.real("ddpg.actor_learning_rate", c.ddpg.actor_learning_rate, 0.0, 1.0);
@@ -405,6 +416,23 @@ void apply_override(toml::table& root, const std::string& assignment) {
   t->insert_or_assign(parts.back(), *parsed.get("v"));
 }
 
+// The registered envs that give the embedded HFO features, and the setting that makes them
+// ("env.name = \"hfo\" or env.name = \"hfo-server\" with env.server_encoding = embedded").
+std::string envs_giving_embedded_features() {
+  std::string out;
+  for (const EnvRegistration& r : env_registry().all()) {
+    EnvParams p = env_registry().defaults();
+    std::string with;
+    if (r.use_embedded_hfo_features) {
+      with = " with " + r.use_embedded_hfo_features(p);
+    }
+    if (r.gives_embedded_hfo_features && r.gives_embedded_hfo_features(p)) {
+      out += (out.empty() ? "" : " or ") + ("env.name = \"" + r.name + "\"") + with;
+    }
+  }
+  return out;
+}
+
 void validate(const ExperimentConfig& c, const std::string& src) {
   if (c.exploration.epsilon_end > c.exploration.epsilon_start) {
     throw std::runtime_error(src + ": exploration.epsilon_end must not exceed exploration.epsilon_start");
@@ -418,8 +446,8 @@ void validate(const ExperimentConfig& c, const std::string& src) {
   if (c.exploration.demo_fraction > 0.0 && !gives_embedded_features(c.env)) {
     throw std::runtime_error(src +
                              ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
-                             "HFO features: use env.name = \"hfo\" (or hfo-server with env.server_encoding = "
-                             "\"embedded\"), or set exploration.demo_fraction = 0");
+                             "HFO features: use " +
+                             envs_giving_embedded_features() + ", or set exploration.demo_fraction = 0");
   }
   if (c.ddpg.demo_bc_weight > 0.0 && c.exploration.demo_fraction <= 0.0) {
     throw std::runtime_error(src +
@@ -443,32 +471,25 @@ void validate(const ExperimentConfig& c, const std::string& src) {
 }  // namespace
 
 const Choices<hfo::StartDistribution>& start_choices() {
-  static const Choices<hfo::StartDistribution> kChoices{{"paper", hfo::StartDistribution::kPaper},
-                                                        {"dec2015", hfo::StartDistribution::kDec2015},
-                                                        {"hfo", hfo::StartDistribution::kHfo}};
-  return kChoices;
+  return hfo::start_names();
 }
 
 const Choices<hfo::Referee>& referee_choices() {
-  static const Choices<hfo::Referee> kChoices{{"server", hfo::Referee::kServer}, {"trainer", hfo::Referee::kTrainer}};
-  return kChoices;
-}
-
-const Choices<std::string>& env_choices() {
-  static const Choices<std::string> kChoices{
-      {"hfo", "hfo"}, {"reach_stop", "reach_stop"}, {"hfo-server", "hfo-server"}};
-  return kChoices;
-}
-
-const Choices<hfo_server::Encoding>& server_encoding_choices() {
-  static const Choices<hfo_server::Encoding> kChoices{{"native", hfo_server::Encoding::kNative},
-                                                      {"embedded", hfo_server::Encoding::kEmbedded}};
-  return kChoices;
+  return hfo::referee_names();
 }
 
 const Choices<hfo::BodyAtReset>& body_at_reset_choices() {
-  static const Choices<hfo::BodyAtReset> kChoices{
-      {"carry", hfo::BodyAtReset::kCarry}, {"zero", hfo::BodyAtReset::kZero}, {"uniform", hfo::BodyAtReset::kUniform}};
+  return hfo::body_at_reset_names();
+}
+
+const Choices<std::string>& env_choices() {
+  static const Choices<std::string> kChoices = [] {
+    Choices<std::string> c;
+    for (const std::string& name : env_registry().names()) {
+      c.emplace_back(name, name);
+    }
+    return c;
+  }();
   return kChoices;
 }
 

@@ -12,32 +12,24 @@
 #include "actor/exploration.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/hfo/soccer_sim.hpp"
-#include "envs/hfo_server/hfo_server_env.hpp"
+#include "envs/registry.hpp"
 #include "learner/ddpg.hpp"
 
 namespace pamdp::app {
 
+// The env of a run: a registered env (envs/registry.hpp) and the env.* settings. `params` holds
+// every registered env's keys, whichever env is named, so that a config file written by one build
+// reads back the same; the env reads its own.
 struct EnvConfig {
-  std::string name = "hfo";  // "hfo", "reach_stop" or "hfo-server"
-  hfo::SoccerSimConfig hfo;
-  // The real HFO server (env.name = "hfo-server", docs/hfo-server.md). Of the keys above, goalie
-  // says the server runs one (bin/HFO --defense-npcs 1) and max_steps is its --frames-per-trial;
-  // the others belong to the embedded simulator (the server's own flags set them).
-  std::string server_host = "localhost";
-  int server_port = 6000;  // bin/HFO --port
-  // The server of the greedy evaluations that `pamdp train` and `pamdp learner` run
-  // (train.eval_every_updates > 0); 0 = none.
-  int server_eval_port = 0;
-  hfo_server::Encoding server_encoding = hfo_server::Encoding::kNative;
-  std::string server_team = "base_left";
-  std::string server_config_dir;      // empty: HFO_ROOT/bin/teams/base/config/formations-dt
-  int server_connect_timeout_s = 30;  // how long an env waits for its server to answer at the first reset()
+  std::string name = "hfo";
+  EnvParams params = env_registry().defaults();
 };
 
-// Whether the env gives the embedded simulator's features, the ones the scripted offense reads:
-// hfo, or hfo-server in the embedded encoding.
+// Whether the env gives the embedded simulator's features, the ones the scripted offense reads
+// (hfo, or hfo-server in the embedded encoding).
 inline bool gives_embedded_features(const EnvConfig& env) {
-  return env.name == "hfo" || (env.name == "hfo-server" && env.server_encoding == hfo_server::Encoding::kEmbedded);
+  const auto& gives = env_registry().find(env.name).gives_embedded_hfo_features;
+  return gives && gives(env.params);
 }
 
 struct ReplayConfig {
@@ -119,8 +111,7 @@ using Choices = std::vector<std::pair<std::string, E>>;
 const Choices<hfo::StartDistribution>& start_choices();
 const Choices<hfo::Referee>& referee_choices();
 const Choices<hfo::BodyAtReset>& body_at_reset_choices();
-const Choices<std::string>& env_choices();
-const Choices<hfo_server::Encoding>& server_encoding_choices();
+const Choices<std::string>& env_choices();  // the registered envs' names
 const Choices<hfo::ShotAim>& shot_aim_choices();
 
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws

@@ -332,6 +332,7 @@ void register_learner(CLI::App& app) {
                   {"TOML config (default: the paper preset)",
                    "override one config key, e.g. --set cluster.learner_bind=tcp://127.0.0.1:6000",
                    "where config, metrics and checkpoints go"});
+  cmd->footer(env_help_footer());
   cmd->callback([o] { run_learner(*o); });
 }
 

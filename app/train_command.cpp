@@ -101,6 +101,7 @@ void register_train(CLI::App& app) {
                    "override one config key, e.g. --set ddpg.gamma=0.95 (repeatable)",
                    "where config, metrics and checkpoints go (default runs/<time>-seed<S>)"});
   cmd->add_flag("--json", o->json, "print one JSON summary object as the last line");
+  cmd->footer(env_help_footer());
   cmd->callback([o] { run_train(*o); });
 }
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "app/env_factory.hpp"
-#include "envs/toy/reach_stop.hpp"
+#include "envs/registry.hpp"
 
 namespace pamdp::python {
 namespace {
@@ -16,31 +16,36 @@ struct Entry {
   std::vector<std::string> options;  // the env.* keys a user may set
 };
 
-const std::vector<std::string> kHfoOptions{"body_at_reset", "goalie", "max_steps",      "noise",
-                                           "referee",       "start",  "untouched_limit"};
-const std::vector<std::string> kHfoFixedGoalie{"body_at_reset", "max_steps", "noise",
-                                               "referee",       "start",     "untouched_limit"};
-// The keys server_config() in app/env_factory.hpp reads.
-const std::vector<std::string> kServerOptions{"goalie",      "max_steps",   "server_config_dir", "server_encoding",
-                                              "server_host", "server_port", "server_team"};
+// The keys env `name` reads (envs/registry.hpp), less `fixed_key`.
+std::vector<std::string> options_of(const std::string& name, const std::string& fixed_key = "") {
+  std::vector<std::string> out;
+  for (const EnvKey& k : env_registry().find(name).keys) {
+    if (k.name != fixed_key) {
+      out.push_back(k.name);
+    }
+  }
+  return out;
+}
 
+// The two HFO set-ups by id, then every registered env by its name, so that a new env is offered
+// here without a line in this file.
 const std::vector<Entry>& entries() {
-  static const std::vector<Entry> kEntries{
-      {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
-       "hfo",
-       {"goalie=false"},
-       kHfoFixedGoalie},
-      {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
-       "hfo",
-       {"goalie=true"},
-       kHfoFixedGoalie},
-      {{"hfo", "embedded Half Field Offense, goalie chosen by the goalie option"}, "hfo", {}, kHfoOptions},
-      {{"reach_stop", "toy task: reach the target on a line, then STOP (3 features)"}, "reach_stop", {}, {}},
-      {{"hfo-server", "the real HFO server through its C++ client (a build with -DHFO_ROOT)"},
-       "hfo-server",
-       {},
-       kServerOptions},
-  };
+  static const std::vector<Entry> kEntries = [] {
+    std::vector<Entry> e{
+        {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
+         "hfo",
+         {"goalie=false"},
+         options_of("hfo", "goalie")},
+        {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
+         "hfo",
+         {"goalie=true"},
+         options_of("hfo", "goalie")},
+    };
+    for (const EnvRegistration& r : env_registry().all()) {
+      e.push_back({{r.name, r.description}, r.name, {}, options_of(r.name)});
+    }
+    return e;
+  }();
   return kEntries;
 }
 
@@ -115,8 +120,12 @@ std::unique_ptr<Env> build_env(const app::EnvConfig& config) {
 }
 
 std::string id_of(const app::EnvConfig& config) {
-  if (config.name == "hfo") {
-    return config.hfo.goalie ? "hfo-1v1" : "hfo-1v0";
+  // The goalie picks between the ids that name env 'hfo' with the goalie fixed.
+  const std::string fixed = config.params.boolean("goalie") ? "goalie=true" : "goalie=false";
+  for (const Entry& e : entries()) {
+    if (e.name == config.name && e.fixed.size() == 1 && e.fixed.front() == fixed) {
+      return e.id.id;
+    }
   }
   return config.name;
 }
@@ -128,12 +137,11 @@ std::string env_toml(const app::EnvConfig& config) {
 }
 
 bool fresh_env_per_seed(const app::EnvConfig& config) {
-  return config.name != "hfo-server";
+  return !env_registry().find(config.name).location;
 }
 
 float observation_bound(const app::EnvConfig& config) {
-  // HFO's features are normalized to [-1, 1] (hfo-reference.md §3); the toy task states its own.
-  return config.name == "reach_stop" ? toy::ReachStopEnv::kObservationBound : 1.0F;
+  return env_registry().find(config.name).observation_bound;
 }
 
 }  // namespace pamdp::python

@@ -1,11 +1,12 @@
 // The envs the Python module offers, by id, and how each is built from its keyword options. This
-// is the one place the binding depends on env construction (a project-wide env registry can
-// replace it without touching the rest of python/).
+// is the one place the binding depends on env construction; the envs and their keys come from the
+// project's env registry (envs/registry.hpp).
 //
-// Ids: "hfo-1v0" (no goalie), "hfo-1v1" (the NPC goalie on), "hfo" (goalie chosen by option),
-// "reach_stop" (the toy task) and "hfo-server" (the real server; needs a build with -DHFO_ROOT).
-// Options are the TOML env.* keys without the "env." prefix ("noise", "start", ...), each a TOML
-// value as text ("false", "\"dec2015\"", "300"), validated by the config file's own reader.
+// Ids: "hfo-1v0" (no goalie), "hfo-1v1" (the NPC goalie on), then every registered env by its
+// env.name: "hfo" (goalie chosen by option), "reach_stop" (the toy task) and "hfo-server" (the
+// real server; needs a build with -DHFO_ROOT). Options are the env.* keys the env reads, without
+// the "env." prefix ("noise", "start", ...), each a TOML value as text ("false", "\"dec2015\"",
+// "300"), validated by the config file's own reader.
 // Not thread-safe only in the sense that nothing here is shared: every call builds fresh objects.
 #pragma once
 

@@ -18,6 +18,7 @@
 
 #include "app/experiment_config.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/settings.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
 
@@ -197,7 +198,7 @@ TEST(Cli, EvalPlaysTheActorAverageByDefaultWhenTheRunKeptOne) {
   const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
   pamdp::app::ExperimentConfig c = pamdp::app::parse_experiment_config(pamdp::read_checkpoint_config(model), model, {});
   c.ddpg.actor_average_tau = 1e-5;
-  pamdp::hfo::HfoEnv env(c.env.hfo);
+  pamdp::hfo::HfoEnv env(pamdp::hfo::sim_config(c.env.params));
   pamdp::Ddpg ddpg(env.observation_size(), env.action_space(), c.ddpg, 1);
   pamdp::CheckpointMeta meta = pamdp::load_checkpoint(model, ddpg);
   const auto target = ddpg.target_actor().params();

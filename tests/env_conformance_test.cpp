@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <set>
@@ -18,6 +20,7 @@
 #include "envs/env.hpp"
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/registry.hpp"
 #include "envs/toy/reach_stop.hpp"
 
 namespace pamdp {
@@ -43,7 +46,7 @@ std::unique_ptr<Env> make_hfo(bool noise, bool goalie = false) {
   return std::make_unique<hfo::HfoEnv>(config);
 }
 
-const EnvCase kEnvCases[] = {
+const EnvCase kHandCases[] = {
     {"HfoNoise", [] { return make_hfo(true); }, hfo::kNumAgentFeatures, 1.0F, 30},
     {"HfoNoNoise", [] { return make_hfo(false); }, hfo::kNumAgentFeatures, 1.0F, 30},
     {"HfoGoalieNoise", [] { return make_hfo(true, true); }, hfo::feature_count(2), 1.0F, 30},
@@ -51,6 +54,24 @@ const EnvCase kEnvCases[] = {
     {"ReachStop", [] { return std::make_unique<toy::ReachStopEnv>(); }, toy::ReachStopEnv::kObservationSize,
      toy::ReachStopEnv::kObservationBound, 200},
 };
+
+// The hand-made cases, and every registered env that plays in-process (envs/registry.hpp) from
+// its defaults, so that a new env passes the harness without a line here.
+std::vector<EnvCase> env_cases() {
+  std::vector<EnvCase> cases(std::begin(kHandCases), std::end(kHandCases));
+  for (const EnvRegistration& r : env_registry().all()) {
+    if (r.location) {
+      continue;  // needs a server of its own (hfo-server: tests/hfo_server_integration_test.sh)
+    }
+    std::string name = "Registered_" + r.name;
+    std::replace_if(
+        name.begin(), name.end(), [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) == 0; }, '_');
+    const EnvParams defaults = env_registry().defaults();
+    cases.push_back(
+        {name, [&r, defaults] { return r.make(defaults); }, r.observation_size(defaults), r.observation_bound, 30});
+  }
+  return cases;
+}
 
 // Everything an episode sequence produced, in order: the observation after every reset and
 // step, every reward and status, and the length of every episode.
@@ -243,7 +264,7 @@ TEST_P(EnvConformance, ResetWithoutSeedContinuesTheStream) {
   EXPECT_NE(bits(first), bits(second)) << "reset() repeated the previous start state";
 }
 
-INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvConformance, ::testing::ValuesIn(kEnvCases),
+INSTANTIATE_TEST_SUITE_P(AllEnvs, EnvConformance, ::testing::ValuesIn(env_cases()),
                          [](const ::testing::TestParamInfo<EnvCase>& info) { return info.param.name; });
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "app/experiment_config.hpp"
 #include "core/rng.hpp"
 #include "envs/hfo/features.hpp"
+#include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/hfo_server/feature_encoding.hpp"
 #include "envs/hfo_server/hfo_server_env.hpp"
@@ -227,23 +228,23 @@ TEST(HfoServerFeatures, ValuesZeroedByAnInvalidFlagStayZero) {
 // The config keys of the real-server env: defaults, validation, round trip.
 TEST(HfoServerConfig, KeysAreValidatedAndRoundTrip) {
   const app::ExperimentConfig def = app::parse_experiment_config("", "defaults", {});
-  EXPECT_EQ(def.env.server_host, "localhost");
-  EXPECT_EQ(def.env.server_port, 6000);
-  EXPECT_EQ(def.env.server_eval_port, 0);
-  EXPECT_EQ(def.env.server_encoding, Encoding::kNative);
-  EXPECT_EQ(def.env.server_team, "base_left");
-  EXPECT_EQ(def.env.server_config_dir, "");
+  EXPECT_EQ(def.env.params.text("server_host"), "localhost");
+  EXPECT_EQ(def.env.params.integer("server_port"), 6000);
+  EXPECT_EQ(def.env.params.integer("server_eval_port"), 0);
+  EXPECT_EQ(server_config(def.env.params).encoding, Encoding::kNative);
+  EXPECT_EQ(def.env.params.text("server_team"), "base_left");
+  EXPECT_EQ(def.env.params.text("server_config_dir"), "");
 
   const app::ExperimentConfig c = app::parse_experiment_config(
       "", "x",
       {"env.name=hfo-server", "env.server_host=10.0.0.7", "env.server_port=7000", "env.server_eval_port=7010",
        "env.server_encoding=embedded", "env.server_config_dir=/opt/HFO/bin/teams/base/config/formations-dt"});
   EXPECT_EQ(c.env.name, "hfo-server");
-  EXPECT_EQ(c.env.server_port, 7000);
-  EXPECT_EQ(c.env.server_encoding, Encoding::kEmbedded);
+  EXPECT_EQ(c.env.params.integer("server_port"), 7000);
+  EXPECT_EQ(server_config(c.env.params).encoding, Encoding::kEmbedded);
   const app::ExperimentConfig back = app::parse_experiment_config(app::to_toml(c), "round-trip", {});
   EXPECT_EQ(app::to_toml(back), app::to_toml(c));
-  EXPECT_EQ(back.env.server_config_dir, "/opt/HFO/bin/teams/base/config/formations-dt");
+  EXPECT_EQ(back.env.params.text("server_config_dir"), "/opt/HFO/bin/teams/base/config/formations-dt");
 
   const auto error_of = [](const std::string& set) {
     try {
@@ -259,8 +260,8 @@ TEST(HfoServerConfig, KeysAreValidatedAndRoundTrip) {
   EXPECT_NE(error_of("env.server_host=''").find("'env.server_host' must be a non-empty string"), std::string::npos);
   EXPECT_NE(error_of("env.name=hfo_server").find("hfo, reach_stop, hfo-server"), std::string::npos);
   EXPECT_NE(error_of("env.server_prot=7000").find("server_port"), std::string::npos);  // lists the valid keys
-  EXPECT_EQ(def.env.server_connect_timeout_s, 30);
-  EXPECT_EQ(app::server_config(app::parse_experiment_config("", "x", {"env.server_connect_timeout_s=5"}).env)
+  EXPECT_EQ(def.env.params.integer("server_connect_timeout_s"), 30);
+  EXPECT_EQ(server_config(app::parse_experiment_config("", "x", {"env.server_connect_timeout_s=5"}).env.params)
                 .connect_timeout_s,
             5);
   EXPECT_NE(error_of("env.server_connect_timeout_s=0").find("'env.server_connect_timeout_s' must be within [1, 3600]"),
@@ -448,11 +449,11 @@ TEST(HfoServerEnv, ObservationSizesComeFromTheConfig) {
   app::EnvConfig e;
   e.name = "hfo-server";
   EXPECT_EQ(app::observation_size(e), 59);
-  e.server_encoding = Encoding::kEmbedded;
+  e.params.set("server_encoding", std::string("embedded"));
   EXPECT_EQ(app::observation_size(e), 58);
-  e.hfo.goalie = true;
+  e.params.set("goalie", true);
   EXPECT_EQ(app::observation_size(e), 66);
-  e.server_encoding = Encoding::kNative;
+  e.params.set("server_encoding", std::string("native"));
   EXPECT_EQ(app::observation_size(e), 68);
 }
 
@@ -461,7 +462,7 @@ TEST(HfoServerEnv, ObservationSizesComeFromTheConfig) {
 TEST(HfoServerEnv, CreationWithoutHfoNamesTheFixAndWithHfoDoesNotConnect) {
   app::EnvConfig e;
   e.name = "hfo-server";
-  e.server_port = 1;  // nothing listens there
+  e.params.set("server_port", int64_t{1});  // nothing listens there
   if (!built_with_hfo()) {
     try {
       (void)app::make_env(e);
@@ -494,7 +495,7 @@ TEST(HfoServerEnv, EvaluationsNeedTheirOwnServer) {
   c.train.eval_episodes = 0;
   EXPECT_NO_THROW((void)app::make_eval_env(c));
   c.train.eval_episodes = 10;
-  c.env.server_eval_port = 7010;
+  c.env.params.set("server_eval_port", int64_t{7010});
   EXPECT_NO_THROW((void)app::make_eval_env(c));
 }
 

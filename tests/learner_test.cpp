@@ -943,7 +943,7 @@ TEST(Config, DefaultsRoundTripAndOverrides) {
       app::parse_experiment_config("", "x", {"ddpg.gamma=0.5", "ddpg.bound=squashing", "env.noise=false", "seed=9"});
   EXPECT_DOUBLE_EQ(o.ddpg.gamma, 0.5);
   EXPECT_EQ(o.ddpg.bound, BoundMethod::kSquashing);
-  EXPECT_FALSE(o.env.hfo.noise);
+  EXPECT_FALSE(o.env.params.boolean("noise"));
   EXPECT_EQ(o.seed, 9U);
 }
 

@@ -36,6 +36,7 @@
 #include "envs/env.hpp"
 #include "envs/hfo/features.hpp"
 #include "envs/hfo_server/feature_encoding.hpp"
+#include "envs/registry.hpp"
 
 namespace pamdp::hfo_server {
 
@@ -67,6 +68,9 @@ inline int observation_size(const HfoServerConfig& config) {
   return config.encoding == Encoding::kNative ? e3_feature_count(0, config.opponents)
                                               : hfo::feature_count(1 + config.opponents);
 }
+
+// The settings the env.* keys of env 'hfo-server' give (envs/hfo_server/registration.cpp).
+HfoServerConfig server_config(const EnvParams& params);
 
 // True when this build links HFO's client library.
 bool built_with_hfo();

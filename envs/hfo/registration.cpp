@@ -1,0 +1,116 @@
+#include <memory>
+#include <stdexcept>
+
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/settings.hpp"
+#include "envs/registry.hpp"
+
+namespace pamdp {
+namespace hfo {
+namespace {
+
+template <typename E>
+std::vector<std::string> names_of(const Names<E>& names) {
+  std::vector<std::string> out;
+  for (const auto& [name, value] : names) {
+    out.push_back(name);
+  }
+  return out;
+}
+
+template <typename E>
+E value_of(const Names<E>& names, const std::string& name) {
+  for (const auto& [n, value] : names) {
+    if (n == name) {
+      return value;
+    }
+  }
+  throw std::logic_error("env setting value '" + name + "' is not a valid choice");  // the config reader checks first
+}
+
+template <typename E>
+std::string name_of(const Names<E>& names, E value) {
+  for (const auto& [name, v] : names) {
+    if (v == value) {
+      return name;
+    }
+  }
+  throw std::logic_error("an hfo setting has a value without a name");
+}
+
+}  // namespace
+
+const Names<StartDistribution>& start_names() {
+  static const Names<StartDistribution> kNames{
+      {"paper", StartDistribution::kPaper}, {"dec2015", StartDistribution::kDec2015}, {"hfo", StartDistribution::kHfo}};
+  return kNames;
+}
+
+const Names<Referee>& referee_names() {
+  static const Names<Referee> kNames{{"server", Referee::kServer}, {"trainer", Referee::kTrainer}};
+  return kNames;
+}
+
+const Names<BodyAtReset>& body_at_reset_names() {
+  static const Names<BodyAtReset> kNames{
+      {"carry", BodyAtReset::kCarry}, {"zero", BodyAtReset::kZero}, {"uniform", BodyAtReset::kUniform}};
+  return kNames;
+}
+
+EnvKey goalie_key() {
+  return EnvKey::boolean("goalie", SoccerSimConfig{}.goalie);
+}
+
+EnvKey max_steps_key() {
+  return EnvKey::integer("max_steps", SoccerSimConfig{}.max_steps, 1, 1000000);
+}
+
+std::vector<EnvKey> sim_keys() {
+  const SoccerSimConfig d;
+  return {
+      EnvKey::boolean("noise", d.noise),
+      EnvKey::choice("start", name_of(start_names(), d.start), names_of(start_names())),
+      EnvKey::choice("referee", name_of(referee_names(), d.referee), names_of(referee_names())),
+      EnvKey::choice("body_at_reset", name_of(body_at_reset_names(), d.body_at_reset), names_of(body_at_reset_names())),
+      max_steps_key(),
+      EnvKey::integer("untouched_limit", d.untouched_limit, 1, 1000000),
+      goalie_key()};
+}
+
+SoccerSimConfig sim_config(const EnvParams& params) {
+  SoccerSimConfig c;
+  c.noise = params.boolean("noise");
+  c.start = value_of(start_names(), params.text("start"));
+  c.referee = value_of(referee_names(), params.text("referee"));
+  c.body_at_reset = value_of(body_at_reset_names(), params.text("body_at_reset"));
+  c.max_steps = static_cast<int>(params.integer("max_steps"));
+  c.untouched_limit = static_cast<int>(params.integer("untouched_limit"));
+  c.goalie = params.boolean("goalie");
+  return c;
+}
+
+void set_sim_config(EnvParams& params, const SoccerSimConfig& config) {
+  params.set("noise", config.noise);
+  params.set("start", name_of(start_names(), config.start));
+  params.set("referee", name_of(referee_names(), config.referee));
+  params.set("body_at_reset", name_of(body_at_reset_names(), config.body_at_reset));
+  params.set("max_steps", int64_t{config.max_steps});
+  params.set("untouched_limit", int64_t{config.untouched_limit});
+  params.set("goalie", config.goalie);
+}
+
+}  // namespace hfo
+
+void register_hfo_env(EnvRegistry& registry) {
+  EnvRegistration r;
+  r.name = "hfo";
+  r.description = "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true)";
+  r.keys = hfo::sim_keys();
+  r.make = [](const EnvParams& p) { return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p)); };
+  r.observation_size = [](const EnvParams& p) { return hfo::HfoEnv(hfo::sim_config(p)).observation_size(); };
+  r.gives_embedded_hfo_features = [](const EnvParams&) { return true; };
+  r.hfo_actions = true;
+  registry.add(std::move(r));
+}
+
+}  // namespace pamdp

@@ -1,0 +1,81 @@
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "envs/hfo/settings.hpp"
+#include "envs/hfo_server/hfo_server_env.hpp"
+#include "envs/registry.hpp"
+
+namespace pamdp {
+namespace hfo_server {
+namespace {
+
+constexpr const char* kEncodingNames[] = {"native", "embedded"};
+
+}  // namespace
+
+HfoServerConfig server_config(const EnvParams& p) {
+  HfoServerConfig s;
+  s.host = p.text("server_host");
+  s.port = static_cast<int>(p.integer("server_port"));
+  s.encoding = p.text("server_encoding") == "embedded" ? Encoding::kEmbedded : Encoding::kNative;
+  s.team = p.text("server_team");
+  s.config_dir = p.text("server_config_dir");
+  s.opponents = p.boolean("goalie") ? 1 : 0;
+  s.max_steps = static_cast<int>(p.integer("max_steps"));
+  s.connect_timeout_s = static_cast<int>(p.integer("server_connect_timeout_s"));
+  return s;
+}
+
+}  // namespace hfo_server
+
+void register_hfo_server_env(EnvRegistry& registry) {
+  const hfo_server::HfoServerConfig d;
+  EnvRegistration r;
+  r.name = "hfo-server";
+  r.description =
+      "the real HFO server through its C++ client (a build with -DHFO_ROOT; the server's own flags set up the game, "
+      "docs/hfo-server.md)";
+  // Of the embedded simulator's keys, goalie says the server runs one (bin/HFO --defense-npcs 1)
+  // and max_steps is its --frames-per-trial.
+  r.keys = {hfo::goalie_key(), hfo::max_steps_key(), EnvKey::text("server_host", d.host),
+            EnvKey::integer("server_port", d.port, 1, 65535),
+            // The server of the greedy evaluations that `pamdp train` and `pamdp learner` run; 0 = none.
+            EnvKey::integer("server_eval_port", 0, 0, 65535),
+            EnvKey::choice("server_encoding", hfo_server::kEncodingNames[static_cast<int>(d.encoding)],
+                           {hfo_server::kEncodingNames[0], hfo_server::kEncodingNames[1]}),
+            EnvKey::text("server_team", d.team), EnvKey::text_or_empty("server_config_dir", d.config_dir),
+            EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600)};
+  r.make = [](const EnvParams& p) { return hfo_server::make_hfo_server_env(hfo_server::server_config(p)); };
+  r.observation_size = [](const EnvParams& p) { return hfo_server::observation_size(hfo_server::server_config(p)); };
+  r.gives_embedded_hfo_features = [](const EnvParams& p) { return p.text("server_encoding") == "embedded"; };
+  r.use_embedded_hfo_features = [](EnvParams& p) {
+    p.set("server_encoding", std::string("embedded"));
+    return std::string("env.server_encoding = embedded");
+  };
+  // Greedy evaluations beside training need a server of their own, asked for only when they run.
+  r.eval_params = [](const EnvParams& p, bool evaluating) {
+    const int64_t eval_port = p.integer("server_eval_port");
+    if (!evaluating) {
+      return p;
+    }
+    if (eval_port == 0 || eval_port == p.integer("server_port")) {
+      throw std::runtime_error(
+          "greedy evaluations on env 'hfo-server' (train.eval_episodes > 0) need an HFO server of their own: start "
+          "one and set env.server_eval_port to its port, or set train.eval_episodes=0");
+    }
+    EnvParams e = p;
+    e.set("server_port", eval_port);
+    return e;
+  };
+  r.location = [](const EnvParams& p) {
+    return " at " + p.text("server_host") + ":" + std::to_string(p.integer("server_port"));
+  };
+  r.hfo_actions = true;
+  r.max_per_process = 1;
+  r.max_per_process_note =
+      "plays one HFO server per actor; start one actor per server, each with --envs 1 --server-port PORT";
+  registry.add(std::move(r));
+}
+
+}  // namespace pamdp
