@@ -9,11 +9,13 @@
 #include <string>
 #include <utility>
 
+#include "core/actor_output.hpp"
 #include "core/bounds.hpp"
 #include "core/log.hpp"
 #include "core/mlp.hpp"
 #include "core/rng.hpp"
 #include "core/wire.hpp"
+#include "replay/episode_buffer.hpp"
 
 namespace pamdp {
 namespace {
@@ -40,52 +42,6 @@ size_t area(int rows, int width) {
   return static_cast<size_t>(rows) * static_cast<size_t>(width);
 }
 
-// Transitions of one env's running episode, kept until it ends so that Monte-Carlo returns can
-// be computed. Sized once for the env's longest episode.
-class EpisodeBuffer {
- public:
-  EpisodeBuffer(int max_steps, int obs, int act)
-      : obs_(static_cast<size_t>(obs)),
-        act_(static_cast<size_t>(act)),
-        states_(area(max_steps, obs)),
-        next_(area(max_steps, obs)),
-        actions_(area(max_steps, act)),
-        rewards_(static_cast<size_t>(max_steps)),
-        returns_(static_cast<size_t>(max_steps)) {}
-
-  void clear() { n_ = 0; }
-  [[nodiscard]] size_t size() const { return n_; }
-  [[nodiscard]] size_t capacity() const { return rewards_.size(); }
-
-  void push(std::span<const float> s, std::span<const float> a, float r, std::span<const float> s2) {
-    std::copy(s.begin(), s.end(), states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    std::copy(a.begin(), a.end(), actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
-    std::copy(s2.begin(), s2.end(), next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    rewards_[n_] = r;
-    ++n_;
-  }
-
-  // G_t = r_t + gamma * G_{t+1}, G after the last step = 0 (in double, as the trainer does).
-  void compute_returns(double gamma) {
-    double g = 0.0;
-    for (size_t i = n_; i-- > 0;) {
-      g = rewards_[i] + gamma * g;
-      returns_[i] = static_cast<float>(g);
-    }
-  }
-
-  [[nodiscard]] const float* state(size_t i) const { return states_.data() + i * obs_; }
-  [[nodiscard]] const float* next_state(size_t i) const { return next_.data() + i * obs_; }
-  [[nodiscard]] const float* action(size_t i) const { return actions_.data() + i * act_; }
-  [[nodiscard]] float reward(size_t i) const { return rewards_[i]; }
-  [[nodiscard]] float mc_return(size_t i) const { return returns_[i]; }
-
- private:
-  size_t obs_, act_;
-  size_t n_ = 0;
-  std::vector<float> states_, next_, actions_, rewards_, returns_;
-};
-
 // Rows of the next TransitionBatch, row-major as the wire wants them.
 class OutgoingBatch {
  public:
@@ -103,13 +59,13 @@ class OutgoingBatch {
   [[nodiscard]] bool full() const { return n_ == rewards_.size(); }
   void clear() { n_ = 0; }
 
-  void append(const EpisodeBuffer& ep, size_t i, bool terminal) {
-    std::copy_n(ep.state(i), obs_, states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    std::copy_n(ep.next_state(i), obs_, next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    std::copy_n(ep.action(i), act_, actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
-    rewards_[n_] = ep.reward(i);
-    returns_[n_] = ep.mc_return(i);
-    terminals_[n_] = terminal ? 1 : 0;
+  void append(const TransitionView& t) {
+    std::copy(t.state.begin(), t.state.end(), states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy(t.next_state.begin(), t.next_state.end(), next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
+    std::copy(t.action.begin(), t.action.end(), actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
+    rewards_[n_] = t.reward;
+    returns_[n_] = t.mc_return;
+    terminals_[n_] = t.terminal ? 1 : 0;
     ++n_;
   }
 
@@ -351,14 +307,7 @@ void ActorLoop::Impl::reset(EnvSlot& slot) {
 }
 
 void ActorLoop::Impl::forward(std::span<const float> obs) {
-  input.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), obs_dim);
-  const auto out = policy->forward(input);
-  const std::span<const float> raw(out.data(), static_cast<size_t>(width));
-  if (squash_output) {
-    squash(raw, bounds, net_out);
-  } else {
-    std::copy(raw.begin(), raw.end(), net_out.begin());
-  }
+  actor_output(*policy, input, obs, squash_output ? &bounds : nullptr, net_out);
 }
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
@@ -382,9 +331,9 @@ void ActorLoop::Impl::step(EnvSlot& slot) {
 void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   EpisodeBuffer& ep = slot.episode;
   ep.compute_returns(config.gamma);
-  // Time-outs count as terminals, as in the paper's code and the single-process trainer.
+  // The last step is terminal, time-outs included, as in the paper's code and `pamdp train`.
   for (size_t i = 0; i < ep.size(); ++i) {
-    batch.append(ep, i, i + 1 == ep.size());
+    batch.append(ep.transition(i));
     if (batch.full()) {
       send_batch();
     }

@@ -25,6 +25,7 @@
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/update_backend.hpp"
+#include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"
 #include "replay/replay_snapshot.hpp"
 
@@ -32,59 +33,6 @@ namespace pamdp::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Transitions of the running episode, kept until it ends so that Monte-Carlo returns can be
-// computed before insertion. Sized once for the env's longest episode.
-class EpisodeBuffer {
- public:
-  EpisodeBuffer(int max_steps, int obs, int act)
-      : obs_(obs),
-        act_(act),
-        states_(size(max_steps, obs)),
-        next_(size(max_steps, obs)),
-        actions_(size(max_steps, act)),
-        rewards_(static_cast<size_t>(max_steps)),
-        returns_(static_cast<size_t>(max_steps)) {}
-  void clear() { n_ = 0; }
-  void push(std::span<const float> s, std::span<const float> a, float r, std::span<const float> s2) {
-    std::copy(s.begin(), s.end(), states_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    std::copy(a.begin(), a.end(), actions_.begin() + static_cast<ptrdiff_t>(n_ * act_));
-    std::copy(s2.begin(), s2.end(), next_.begin() + static_cast<ptrdiff_t>(n_ * obs_));
-    rewards_[n_] = r;
-    ++n_;
-  }
-  // Inserts every transition with its discounted return; the last one is terminal if the
-  // episode ended (always, here: time-outs count as terminals as in the paper's code). `also`,
-  // when given, receives the same transitions.
-  void flush(ReplayBuffer& replay, double gamma, ReplayBuffer* also = nullptr) {
-    double g = 0.0;
-    for (size_t i = n_; i-- > 0;) {
-      g = rewards_[i] + gamma * g;
-      returns_[i] = static_cast<float>(g);
-    }
-    for (size_t i = 0; i < n_; ++i) {
-      const TransitionView t{{states_.data() + i * obs_, obs_},
-                             {actions_.data() + i * act_, act_},
-                             rewards_[i],
-                             {next_.data() + i * obs_, obs_},
-                             i + 1 == n_,
-                             returns_[i]};
-      replay.insert(t);
-      if (also != nullptr) {
-        also->insert(t);
-      }
-    }
-    n_ = 0;
-  }
-  [[nodiscard]] size_t capacity() const { return rewards_.size(); }
-  [[nodiscard]] size_t size() const { return n_; }
-
- private:
-  static size_t size(int steps, int width) { return static_cast<size_t>(steps) * static_cast<size_t>(width); }
-  size_t obs_, act_;
-  size_t n_ = 0;
-  std::vector<float> states_, next_, actions_, rewards_, returns_;
-};
 
 class Trainer {
  public:
@@ -469,9 +417,9 @@ TrainSummary Trainer::run() {
       log_tick(false);
     } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
 
-    episode_.flush(replay_, c_.ddpg.gamma, demo && demo_replay_ ? &*demo_replay_ : nullptr);
+    flush_episode(episode_, c_.ddpg.gamma, replay_, demo && demo_replay_ ? &*demo_replay_ : nullptr);
     if (label) {
-      labelled_->flush(*demo_replay_, c_.ddpg.gamma);
+      flush_episode(*labelled_, c_.ddpg.gamma, *demo_replay_);
     }
     backend_->sync_actor_to_host();
     ++episodes_;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/actor_output.hpp"
+
 namespace pamdp {
 namespace {
 
@@ -113,14 +115,8 @@ void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf
 
 void Ddpg::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
   assert(static_cast<int>(obs.size()) == obs_dim_ && static_cast<int>(out.size()) == output_width());
-  single_in_.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), obs_dim_);
   Mlp<float>& net = copy == ActorCopy::kTarget ? target_actor_ : copy == ActorCopy::kAverage ? actor_average_ : actor_;
-  const auto raw = net.forward(single_in_);
-  if (config_.bound == BoundMethod::kSquashing) {
-    squash({raw.data(), static_cast<size_t>(raw.rows())}, bounds_, out);
-  } else {
-    Eigen::Map<Eigen::VectorXf>(out.data(), output_width()) = raw.col(0);
-  }
+  actor_output(net, single_in_, obs, config_.bound == BoundMethod::kSquashing ? &bounds_ : nullptr, out);
 }
 
 void Ddpg::schedule_learning_rates() {

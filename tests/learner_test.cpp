@@ -17,6 +17,7 @@
 #include "actor/exploration.hpp"
 #include "app/experiment_config.hpp"
 #include "app/trainer.hpp"
+#include "core/actor_output.hpp"
 #include "core/files.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
@@ -25,6 +26,7 @@
 #include "learner/ddpg.hpp"
 #include "learner/gradient_bounds.hpp"
 #include "learner/update_backend.hpp"
+#include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"
 #include "replay/replay_snapshot.hpp"
 
@@ -212,6 +214,73 @@ TEST(ReplayBuffer, FifoAndSampling) {
   for (size_t j = 0; j < 64; ++j) {
     EXPECT_EQ(out.terminal[j], out.rewards[j] == 4.0F ? 1.0F : 0.0F);
   }
+}
+
+// The one episode buffer of `pamdp train` and the actors: returns by hand for gamma = 0.5,
+// the last step terminal (time-outs too), and flush_episode into replay and a second buffer.
+TEST(EpisodeBuffer, ReturnsTerminalAndFlush) {
+  EpisodeBuffer ep(4, 2, 1);
+  EXPECT_EQ(ep.capacity(), 4U);
+  const float rewards[3] = {1.0F, 0.0F, 4.0F};
+  for (int i = 0; i < 3; ++i) {
+    const float s[2] = {static_cast<float>(i), -1.0F};
+    const float a[1] = {10.0F + static_cast<float>(i)};
+    const float s2[2] = {static_cast<float>(i + 1), -1.0F};
+    ep.push(s, a, rewards[i], s2);
+  }
+  ASSERT_EQ(ep.size(), 3U);
+  ep.compute_returns(0.5);
+  // G2 = 4, G1 = 0 + 0.5 * 4 = 2, G0 = 1 + 0.5 * 2 = 2.
+  const float want[3] = {2.0F, 2.0F, 4.0F};
+  for (size_t i = 0; i < 3; ++i) {
+    const TransitionView t = ep.transition(i);
+    EXPECT_FLOAT_EQ(t.mc_return, want[i]) << i;
+    EXPECT_EQ(t.terminal, i == 2) << i;
+    EXPECT_EQ(t.state[0], static_cast<float>(i));
+    EXPECT_EQ(t.next_state[0], static_cast<float>(i + 1));
+    EXPECT_EQ(t.action[0], 10.0F + static_cast<float>(i));
+    EXPECT_EQ(t.reward, rewards[i]);
+  }
+  ReplayBuffer replay(8, 2, 1);
+  ReplayBuffer also(8, 2, 1);
+  flush_episode(ep, 0.5, replay, &also);
+  EXPECT_EQ(ep.size(), 0U);
+  EXPECT_EQ(replay.inserted(), 3);
+  EXPECT_EQ(also.inserted(), 3);
+  Rng rng(3);
+  BatchBuffers out(2, 1, 64);
+  replay.sample(rng, 64, out);
+  for (size_t j = 0; j < 64; ++j) {
+    const int i = static_cast<int>(out.states[2 * j]);
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, 3);
+    EXPECT_FLOAT_EQ(out.mc_returns[j], want[i]);
+    EXPECT_EQ(out.terminal[j], i == 2 ? 1.0F : 0.0F);
+  }
+}
+
+// The one "act with this policy" function: raw output without squashing, the tanh map into
+// the bounds with it, for the same network and observation.
+TEST(ActorOutput, RawOrSquashed) {
+  Mlp<float> net({3, 4, 2}, 1);
+  Rng rng(7);
+  net.init_gaussian(rng, 0.5F);
+  Eigen::MatrixXf input(3, 1);
+  const float obs[3] = {0.3F, -0.2F, 0.9F};
+  float raw[2];
+  actor_output(net, input, obs, nullptr, raw);
+  Eigen::MatrixXf x(3, 1);
+  x << 0.3F, -0.2F, 0.9F;
+  const Eigen::MatrixXf ref = net.forward(x);
+  EXPECT_EQ(raw[0], ref(0, 0));
+  EXPECT_EQ(raw[1], ref(1, 0));
+  OutputBounds b;
+  b.lo = {-1.0F, 0.0F};
+  b.hi = {1.0F, 100.0F};
+  float sq[2];
+  actor_output(net, input, obs, &b, sq);
+  EXPECT_FLOAT_EQ(sq[0], std::tanh(raw[0]));
+  EXPECT_FLOAT_EQ(sq[1], 50.0F * (std::tanh(raw[1]) + 1.0F));
 }
 
 TEST(ReplayBuffer, SnapshotRoundTripAndCorruption) {
