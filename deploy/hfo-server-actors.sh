@@ -6,13 +6,16 @@
 #
 #   deploy/hfo-server-actors.sh --hfo-root DIR --join tcp://LEARNER:5555 [--actors N]
 #                               [--base-port P] [--seed S] [--log-dir DIR] [--goalie]
+#                               [--curve-keys DIR | --insecure]
 #
 # Defaults: 1 actor, base port 7000, seed 1 (server i of restart r: S + 100 i + r), logs in
 # runs/hfo-servers. The learner runs with --set env.name=hfo-server (and train.eval_episodes=0,
 # or env.server_eval_port with a server of its own); with --goalie each server gets one goalie
 # (--defense-npcs 1) and the learner needs env.goalie=true. PAMDP_BIN picks the pamdp binary
 # (default build/bin/pamdp; it must be built with -DHFO_ROOT); servers run as
-# `/usr/bin/python3 HFO/bin/HFO ...` (HFO_PYTHON overrides the interpreter).
+# `/usr/bin/python3 HFO/bin/HFO ...` (HFO_PYTHON overrides the interpreter). --curve-keys and
+# --insecure go to every actor as `pamdp actor` takes them: a learner on another machine needs
+# one of them (CURVE with client.keys from pamdp keygen, or a trusted private network).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -24,8 +27,9 @@ base_port=7000
 seed=1
 log_dir=runs/hfo-servers
 goalie=0
+security=()
 
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "hfo-server-actors: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -38,6 +42,8 @@ while [[ $# -gt 0 ]]; do
     --seed) need_value "$@"; seed=$2; shift 2 ;;
     --log-dir) need_value "$@"; log_dir=$2; shift 2 ;;
     --goalie) goalie=1; shift ;;
+    --curve-keys) need_value "$@"; security=(--curve-keys "$2"); shift 2 ;;
+    --insecure) security=(--insecure); shift ;;
     -h|--help) usage; exit 0 ;;
     *) die "unknown option '$1' (see --help)" ;;
   esac
@@ -50,6 +56,10 @@ hfo_root=$(cd "$hfo_root" 2>/dev/null && pwd) || die "--hfo-root: no such direct
 [[ $base_port =~ ^[0-9]+$ && $base_port -ge 1024 && $((base_port + 10 * actors)) -le 65535 ]] ||
   die "--base-port must leave room for $actors servers 10 ports apart below 65536, got '$base_port'"
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, got '$seed'"
+if [[ ${security[0]:-} == --curve-keys ]]; then
+  [[ -f ${security[1]}/client.keys ]] ||
+    die "--curve-keys: no client.keys in '${security[1]}' (make the keys with pamdp keygen, and give the directory holding client.keys)"
+fi
 bin=${PAMDP_BIN:-$root/build/bin/pamdp}
 [[ -x $bin ]] || die "no pamdp binary at $bin (build with -DHFO_ROOT, or set PAMDP_BIN)"
 # bin/HFO starts with '#!/usr/bin/env python', and Debian 12 has no 'python': run it with python3
@@ -82,7 +92,7 @@ run_pair() {
     done
     if kill -0 "$server" 2>/dev/null && ((stopping == 0)); then
       "$bin" actor --join "$join" --server-port "$port" --seed $((1000 + i)) --name "hfo-actor-$i" \
-        >>"$log_dir/actor-$i.log" 2>&1 &
+        "${security[@]}" >>"$log_dir/actor-$i.log" 2>&1 &
       actor=$!
       wait "$actor" || true
       wait "$actor" 2>/dev/null || true  # a trap interrupts the first wait
