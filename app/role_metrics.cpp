@@ -234,6 +234,8 @@ LearnerMetrics::LearnerMetrics(Registry& r, const Env& env, const ExplorationCon
       waiting_(r.counter("pamdp_learner_waiting_for_data_seconds_total",
                          "Time the learner had no sampled batch to update on")),
       refused_(r.counter("pamdp_connections_refused_total", kRefusedHelp)),
+      reports_refused_(r.counter("pamdp_learner_episode_reports_refused_total",
+                                 "Episode reports dropped because the sender has not joined as an actor")),
       weights_version_(r.gauge("pamdp_learner_weights_version", "Version of the newest published weights")),
       shards_(r.gauge("pamdp_learner_peers_connected", "Peers in the cluster now", {{"role", "replay"}})),
       actors_(r.gauge("pamdp_learner_peers_connected", "Peers in the cluster now", {{"role", "actor"}})),
@@ -246,6 +248,7 @@ void LearnerMetrics::on_tick(const LearnerCounters& c, int64_t updates_total, si
   actors_joined_.set(c.actors_joined);
   waiting_.set(c.waiting_for_data_ms / 1000);
   refused_.set(c.connections_refused);
+  reports_refused_.set(c.episode_reports_refused);
   weights_version_.set(static_cast<double>(c.weights_version));
   shards_.set(static_cast<double>(c.shards));
   actors_.set(static_cast<double>(c.actors_alive));

@@ -133,6 +133,7 @@ class LearnerMetrics {
   metrics::Counter& actors_joined_;
   metrics::Counter& waiting_;
   metrics::Counter& refused_;
+  metrics::Counter& reports_refused_;
   metrics::Gauge& weights_version_;
   metrics::Gauge& shards_;
   metrics::Gauge& actors_;

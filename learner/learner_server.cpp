@@ -174,6 +174,15 @@ void LearnerServer::handle_join_socket() {
       }
       case wire::Payload::EpisodeReport: {
         const auto* r = env->payload_as_EpisodeReport();
+        // Only an actor that joined this learner reports episodes: anything else (a stray peer,
+        // or an actor whose learner restarted, until it joins again) is counted and dropped.
+        if (actor_index_.count(id) == 0) {
+          if (counters_.episode_reports_refused++ % 1000 == 0) {
+            log::warn("learner: episode report from a peer that has not joined as an actor, dropped ({} so far)",
+                      counters_.episode_reports_refused);
+          }
+          break;
+        }
         ++counters_.episodes;
         if (on_episode) {
           on_episode({r->actor_id(), r->return_(), r->steps(), r->status(), r->policy_version()});

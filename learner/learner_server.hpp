@@ -55,7 +55,8 @@ struct LearnerCounters {
   int64_t actors_joined = 0;
   int64_t actors_alive = 0;  // actors heard from within peer_timeout_ms
   int64_t waiting_for_data_ms = 0;
-  int64_t connections_refused = 0;  // failed handshakes at the join and weights sockets (no or wrong CURVE key)
+  int64_t connections_refused = 0;      // failed handshakes at the join and weights sockets (no or wrong CURVE key)
+  int64_t episode_reports_refused = 0;  // dropped: the sender has not joined this learner as an actor
 };
 
 struct EpisodeSummary {

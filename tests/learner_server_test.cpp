@@ -224,6 +224,51 @@ TEST(LearnerServer, EveryRandomFrameAtTheJoinSocketIsCounted) {
   EXPECT_EQ(server.counters().malformed_messages, kFrames);
 }
 
+// Episode reports count only from an actor that joined this learner: a peer that never joined
+// (or an actor of a learner that restarted, until it joins again) is counted as refused and its
+// reports reach neither the episode count nor on_episode.
+TEST(LearnerServer, EpisodeReportsOnlyFromJoinedActors) {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  CpuUpdateBackend backend{ddpg};
+  LearnerServer server(ctx, backend, loopback_config());
+  std::atomic<int> reported{0};
+  server.on_episode = [&](const EpisodeSummary&) { reported.fetch_add(1); };
+  std::thread thread([&] { server.run(); });
+  flatbuffers::FlatBufferBuilder fbb;
+  net::Message m;
+  // Every frame a socket sent before its MetricsUrlsRequest was handled before the answer.
+  const auto settle = [&](net::Socket& s) {
+    wire::build_metrics_urls_request(fbb);
+    ASSERT_TRUE(s.send(wire::bytes_of(fbb), 1000));
+    ASSERT_NE(await_payload(s, m, wire::Payload::MetricsUrls), nullptr);
+  };
+  net::Socket stranger(ctx, net::SocketType::kDealer);
+  stranger.connect(server.join_endpoint());
+  for (uint64_t e = 1; e <= 3; ++e) {
+    wire::build_episode_report(fbb, 0, e, 1.0F, 5, 1, 1);
+    ASSERT_TRUE(stranger.send(wire::bytes_of(fbb), 1000));
+  }
+  settle(stranger);
+  net::Socket actor(ctx, net::SocketType::kDealer);
+  actor.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Actor, "actor", "", "", 1, "");
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  ASSERT_NE(await_payload(actor, m, wire::Payload::ClusterMap), nullptr);
+  for (uint64_t e = 1; e <= 2; ++e) {
+    wire::build_episode_report(fbb, 0, e, 1.0F, 5, 1, 1);
+    ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  }
+  settle(actor);
+  server.stop();
+  thread.join();
+  EXPECT_EQ(server.counters().episodes, 2);
+  EXPECT_EQ(server.counters().episode_reports_refused, 3);
+  EXPECT_EQ(server.counters().malformed_messages, 0);
+  EXPECT_EQ(reported.load(), 2);
+}
+
 TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   net::Context ctx;
   toy::ReachStopEnv env;
