@@ -302,8 +302,10 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
     (void)registration.use_embedded_hfo_features(c.env.params);  // the scripted offense reads the embedded features
   }
   c = with_env_overrides(c, o.sets);
-  if (!env_registry().find(c.env.name).hfo_actions) {
-    throw std::runtime_error("--policy " + o.policy + " plays HFO; env '" + c.env.name + "' takes --checkpoint");
+  const bool hfo_actions = env_registry().find(c.env.name).hfo_actions;
+  if (!hfo_actions && o.policy == "scripted") {
+    throw std::runtime_error("--policy scripted plays HFO; env '" + c.env.name +
+                             "' takes --checkpoint FILE, or --policy random (uniform over its actions and parameters)");
   }
   if (o.policy == "scripted" && !gives_embedded_features(c.env)) {
     const auto& use_embedded = env_registry().find(c.env.name).use_embedded_hfo_features;
@@ -324,12 +326,15 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {
     policy = std::make_unique<hfo::ScriptedOffense>(o.shot);
-  } else {
+  } else if (hfo_actions) {
     // The paper's exploration draw: Tackle masked, dash power U[-100, 100] (reference §7.3).
     auto random = std::make_unique<RandomPolicy>(env->action_space(), o.seed ^ 0x5eedULL,
                                                  std::vector<int>{hfo::kDash, hfo::kTurn, hfo::kKick});
     random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
     policy = std::move(random);
+  } else {
+    // Any other env: every action, each parameter uniform over its range.
+    policy = std::make_unique<RandomPolicy>(env->action_space(), o.seed ^ 0x5eedULL);
   }
   print_result(o.policy, evaluate_with_progress(std::move(env), *policy, o), o.json);
 }
@@ -353,7 +358,8 @@ void register_eval(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--env", opts->env,
                   "play on this env instead: " + env_registry().names_joined() +
-                      " (--policy plays envs with HFO's actions, others take --checkpoint); a checkpoint trained on "
+                      " (--policy scripted plays envs with HFO's actions; others take --checkpoint or --policy "
+                      "random); a checkpoint trained on "
                       "the embedded simulator gets the embedded features where the env can give them")
       ->check(CLI::IsMember(env_registry().names()));
   cmd->add_option("--set", opts->sets,

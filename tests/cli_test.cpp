@@ -142,6 +142,19 @@ TEST(Cli, EvalJsonLastLineHasEveryKey) {
   EXPECT_LE(rate, 1.0);
 }
 
+// An env without HFO's actions (Platform) plays --policy random over all its actions and
+// parameters; the scripted offense is refused there with the ways that work.
+TEST(Cli, EvalRandomPolicyPlaysAnyEnv) {
+  const RunResult r = run_pamdp("eval --env platform --policy random --episodes 50 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(last_line(r.output));
+  EXPECT_EQ(j.value("episodes", -1), 50);
+  EXPECT_TRUE(j.at("outcomes").contains("FELL")) << r.output;
+  const RunResult scripted = run_pamdp("eval --env platform --episodes 5");
+  EXPECT_NE(scripted.exit_code, 0);
+  EXPECT_NE(scripted.output.find("takes --checkpoint FILE, or --policy random"), std::string::npos) << scripted.output;
+}
+
 // --trace writes one CSV row per step (plus a header naming every column) and leaves the
 // table and the JSON as they are without it.
 TEST(Cli, EvalTraceWritesOneRowPerStep) {

@@ -29,6 +29,7 @@
 #include "envs/hfo_server/hfo_server_env.hpp"
 #include "envs/hfo_server/server_action.hpp"
 #include "envs/hfo_server/server_probe.hpp"
+#include "envs/registry.hpp"
 #include "learner/evaluation.hpp"
 
 namespace pamdp::hfo_server {
@@ -258,7 +259,7 @@ TEST(HfoServerConfig, KeysAreValidatedAndRoundTrip) {
   EXPECT_NE(error_of("env.server_port=70000").find("env.server_port"), std::string::npos);
   EXPECT_NE(error_of("env.server_encoding=e3").find("native, embedded"), std::string::npos);
   EXPECT_NE(error_of("env.server_host=''").find("'env.server_host' must be a non-empty string"), std::string::npos);
-  EXPECT_NE(error_of("env.name=hfo_server").find("hfo, reach_stop, hfo-server"), std::string::npos);
+  EXPECT_NE(error_of("env.name=hfo_server").find(env_registry().names_joined()), std::string::npos);
   EXPECT_NE(error_of("env.server_prot=7000").find("server_port"), std::string::npos);  // lists the valid keys
   EXPECT_EQ(def.env.params.integer("server_connect_timeout_s"), 30);
   EXPECT_EQ(server_config(app::parse_experiment_config("", "x", {"env.server_connect_timeout_s=5"}).env.params)
