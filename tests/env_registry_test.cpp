@@ -23,8 +23,8 @@ EnvRegistration toy_registration(const std::string& name, std::vector<EnvKey> ke
 }
 
 TEST(EnvRegistry, ListsTheBuildsEnvsInTheBuildFilesOrder) {
-  EXPECT_EQ(env_registry().names(), (std::vector<std::string>{"hfo", "reach_stop", "hfo-server"}));
-  EXPECT_EQ(env_registry().names_joined(), "hfo, reach_stop, hfo-server");
+  EXPECT_EQ(env_registry().names(), (std::vector<std::string>{"hfo", "reach_stop", "hfo-server", "goal"}));
+  EXPECT_EQ(env_registry().names_joined(), "hfo, reach_stop, hfo-server, goal");
 }
 
 TEST(EnvRegistry, AnUnknownNameIsAnErrorListingTheRegisteredNames) {
@@ -33,7 +33,7 @@ TEST(EnvRegistry, AnUnknownNameIsAnErrorListingTheRegisteredNames) {
     (void)env_registry().find("hfo_server");
     FAIL() << "found an unregistered env";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("'hfo_server' is unknown (valid: hfo, reach_stop, hfo-server)"),
+    EXPECT_NE(std::string(e.what()).find("'hfo_server' is unknown (valid: hfo, reach_stop, hfo-server, goal)"),
               std::string::npos)
         << e.what();
   }
