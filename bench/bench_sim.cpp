@@ -1,10 +1,15 @@
 // BM_SimStep: one embedded-HFO env step (physics + referee + 58 features + reward) driven by
 // a fixed-cost scripted action stream, items = env steps.
+// BM_GoalStep: one Robot Soccer Goal decision step (every internal simulation step it runs, and
+// the 17 features), items = decision steps; the counter sim_steps is the internal step rate.
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
+#include "core/rng.hpp"
+#include "envs/goal/goal_env.hpp"
 #include "envs/hfo/hfo_env.hpp"
 
 namespace {
@@ -38,5 +43,40 @@ void BM_SimStepGoalie(benchmark::State& state) {
   run_sim_steps(state, {.goalie = true});
 }
 BENCHMARK(BM_SimStepGoalie);
+
+void BM_GoalStep(benchmark::State& state) {
+  pamdp::goal::GoalEnv env;
+  std::array<float, pamdp::goal::GoalEnv::kObservationSize> obs{};
+  env.reset(7, obs);
+  // Random play, drawn up front so that the loop measures the env, not a policy: a uniform
+  // action with every parameter uniform in its range (an exploring learner's early actions).
+  const pamdp::ActionSpace& space = env.action_space();
+  constexpr size_t kActions = 4096;
+  std::vector<int> ids(kActions);
+  std::vector<std::array<float, 4>> params(kActions);
+  pamdp::Rng rng(11);
+  for (size_t i = 0; i < kActions; ++i) {
+    ids[i] = static_cast<int>(rng.below(static_cast<uint64_t>(space.num_actions())));
+    for (size_t p = 0; p < params[i].size(); ++p) {
+      params[i][p] = static_cast<float>(rng.uniform(space.params[p].lo, space.params[p].hi));
+    }
+  }
+  size_t k = 0;
+  int64_t sim_steps = 0;
+  for (auto _ : state) {
+    const size_t i = k++ % kActions;
+    const auto r = env.step({ids[i], params[i]}, obs);
+    sim_steps += env.last_sim_steps();
+    if (r.terminal()) {
+      env.reset(obs);
+    }
+    benchmark::DoNotOptimize(obs.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["sim_steps"] = benchmark::Counter(static_cast<double>(sim_steps), benchmark::Counter::kIsRate);
+  state.counters["sim_steps_per_step"] =
+      benchmark::Counter(static_cast<double>(sim_steps) / static_cast<double>(state.iterations()));
+}
+BENCHMARK(BM_GoalStep);
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "core/policy.hpp"
 #include "counting_new.hpp"
+#include "envs/goal/goal_env.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/toy/reach_stop.hpp"
@@ -99,6 +100,33 @@ TEST(ReachStopAllocations, StepAndResetAllocateNothing) {
     allocations = scope.count();
   }
   EXPECT_GT(steps, 50);
+  EXPECT_EQ(allocations, 0);
+}
+
+// Robot Soccer Goal: every internal simulation step of a decision runs inside step().
+TEST(GoalEnvAllocations, StepAndResetAllocateNothing) {
+  goal::GoalEnv env;
+  std::vector<float> obs(static_cast<size_t>(env.observation_size()));
+  RandomPolicy policy(env.action_space(), 5);
+  env.reset(1, obs);
+  (void)env.step(policy.act(obs), obs);
+
+  long allocations = 0;
+  int steps = 0;
+  {
+    CountAllocations scope;
+    for (int ep = 0; ep < 200; ++ep) {
+      env.reset(obs);
+      StepResult r;
+      do {
+        r = env.step(policy.act(obs), obs);
+        ++steps;
+      } while (!r.terminal());
+    }
+    env.reset(99, obs);
+    allocations = scope.count();
+  }
+  EXPECT_GT(steps, 200);
   EXPECT_EQ(allocations, 0);
 }
 

@@ -1,0 +1,1 @@
+# Stand-in: gym-goal imports pygame only to render.
