@@ -14,6 +14,7 @@
 #include "envs/goal/goal_env.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/platform/platform_env.hpp"
 #include "envs/toy/reach_stop.hpp"
 
 using pamdp::testing::alloc::CountAllocations;
@@ -78,44 +79,18 @@ TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithGoalie) {
   expect_hfo_hot_path_allocation_free(true, true);
 }
 
-TEST(ReachStopAllocations, StepAndResetAllocateNothing) {
-  toy::ReachStopEnv env;
-  std::vector<float> obs(static_cast<size_t>(env.observation_size()));
-  RandomPolicy policy(env.action_space(), 4);
-  env.reset(1, obs);
-  (void)env.step(policy.act(obs), obs);
-
-  long allocations = 0;
-  int steps = 0;
-  {
-    CountAllocations scope;
-    for (int ep = 0; ep < 50; ++ep) {
-      env.reset(obs);
-      StepResult r;
-      do {
-        r = env.step(policy.act(obs), obs);
-        ++steps;
-      } while (!r.terminal());
-    }
-    allocations = scope.count();
-  }
-  EXPECT_GT(steps, 50);
-  EXPECT_EQ(allocations, 0);
-}
-
-// Robot Soccer Goal: every internal simulation step of a decision runs inside step().
-TEST(GoalEnvAllocations, StepAndResetAllocateNothing) {
-  goal::GoalEnv env;
+// Plays `episodes` random episodes of `env` inside a counting scope (reset() and reset(seed)
+// too) and expects no allocation; `min_steps` guards against a harness that plays nothing.
+void expect_env_allocation_free(Env& env, int episodes, int min_steps) {
   std::vector<float> obs(static_cast<size_t>(env.observation_size()));
   RandomPolicy policy(env.action_space(), 5);
   env.reset(1, obs);
   (void)env.step(policy.act(obs), obs);
-
   long allocations = 0;
   int steps = 0;
   {
     CountAllocations scope;
-    for (int ep = 0; ep < 200; ++ep) {
+    for (int ep = 0; ep < episodes; ++ep) {
       env.reset(obs);
       StepResult r;
       do {
@@ -126,8 +101,25 @@ TEST(GoalEnvAllocations, StepAndResetAllocateNothing) {
     env.reset(99, obs);
     allocations = scope.count();
   }
-  EXPECT_GT(steps, 200);
+  EXPECT_GT(steps, min_steps);
   EXPECT_EQ(allocations, 0);
+}
+
+TEST(ReachStopAllocations, StepAndResetAllocateNothing) {
+  toy::ReachStopEnv env;
+  expect_env_allocation_free(env, 50, 50);
+}
+
+// Robot Soccer Goal: every internal simulation step of a decision runs inside step().
+TEST(GoalEnvAllocations, StepAndResetAllocateNothing) {
+  goal::GoalEnv env;
+  expect_env_allocation_free(env, 200, 200);
+}
+
+// Platform: every tick of a decision, noise included, runs inside step().
+TEST(PlatformEnvAllocations, StepAndResetAllocateNothing) {
+  platform::PlatformEnv env;
+  expect_env_allocation_free(env, 200, 200);
 }
 
 }  // namespace
