@@ -92,6 +92,8 @@ struct EnvSlot {
   std::unique_ptr<Env> env;
   std::vector<float> obs, next_obs, stored;
   EpisodeBuffer episode;
+  std::unique_ptr<Policy> teacher;  // with demonstrations
+  bool demo = false;                // this episode is the teacher's
   uint64_t seed = 0;
   uint64_t episodes = 0;
   double ret = 0.0;
@@ -141,6 +143,9 @@ ActorLoopConfig checked(ActorLoopConfig c) {
   if (!(c.gamma >= 0.0 && c.gamma <= 1.0)) {
     throw std::invalid_argument("ActorLoop: gamma must lie in [0, 1]");
   }
+  if (c.exploration.demo_fraction > 0.0 && !c.make_teacher) {
+    throw std::invalid_argument("ActorLoop: exploration.demo_fraction > 0 needs a teacher (make_teacher)");
+  }
   if (c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 || c.send_attempt_ms < 1 || c.tick_ms < 1 || c.shard_send_hwm < 1) {
     throw std::invalid_argument(
         "ActorLoop: heartbeat_ms, peer_timeout_ms, send_attempt_ms, tick_ms and shard_send_hwm must be positive");
@@ -189,6 +194,7 @@ struct ActorLoop::Impl {
   int obs_dim;
   int width;
   int num_actions;
+  const ActionSpace& space;
   OutputBounds bounds;
   uint32_t actor_index;
 
@@ -238,6 +244,7 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
       obs_dim(first_env(env_list).observation_size()),
       width(env_list.front()->action_space().output_width()),
       num_actions(env_list.front()->action_space().num_actions()),
+      space(env_list.front()->action_space()),
       bounds(OutputBounds::for_actor(env_list.front()->action_space())),
       actor_index(map.actor_index),
       sub(ctx, net::SocketType::kSub),
@@ -252,6 +259,9 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
   envs.reserve(env_list.size());
   for (size_t k = 0; k < env_list.size(); ++k) {
     envs.emplace_back(std::move(env_list[k]), obs_dim, width, mix_seeds(actor_seed, k));
+    if (config.make_teacher) {
+      envs.back().teacher = config.make_teacher();
+    }
   }
   sub.set_max_message_bytes(kMaxWeightsBytes);
   sub.set_recv_hwm(4);  // only the newest weights matter
@@ -304,6 +314,13 @@ void ActorLoop::Impl::reset(EnvSlot& slot) {
   slot.episode.clear();
   slot.ret = 0.0;
   slot.steps = 0;
+  // The draw is skipped when demonstrations are off, so runs without them keep their streams.
+  const ExplorationConfig& x = config.exploration;
+  const double share = demo_share(updates, x.demo_fraction, x.demo_anneal_updates);
+  slot.demo = share > 0.0 && explore.rng().uniform() < share;
+  if (slot.demo) {
+    slot.teacher->begin_episode();
+  }
 }
 
 void ActorLoop::Impl::forward(std::span<const float> obs) {
@@ -311,11 +328,13 @@ void ActorLoop::Impl::forward(std::span<const float> obs) {
 }
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
-  // At ε = 1 the network's output is never used, so it is not computed.
-  if (policy != nullptr && eps < 1.0) {
+  // At ε = 1 the network's output is never used, so it is not computed (a demonstration stores it
+  // as the parameters of the actions the teacher did not take).
+  if (policy != nullptr && (eps < 1.0 || slot.demo)) {
     forward(slot.obs);
   }
-  const int id = explore.select(net_out, eps, slot.stored);
+  const int id = slot.demo ? write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.stored)
+                           : explore.select(net_out, eps, slot.stored);
   const StepResult sr = slot.env->step(
       {id, std::span<const float>(slot.stored).subspan(static_cast<size_t>(num_actions))}, slot.next_obs);
   slot.episode.push(slot.obs, slot.stored, sr.reward, slot.next_obs);
@@ -341,7 +360,8 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   ++slot.episodes;
   const int64_t episode = counters.episodes.fetch_add(1, std::memory_order_relaxed) + 1;
   if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), static_cast<float>(slot.ret),
-                                static_cast<uint32_t>(slot.steps), status, weights_version)) {
+                                static_cast<uint32_t>(slot.steps), status, slot.demo ? 0 : weights_version,
+                                slot.demo)) {
     counters.reports_dropped.fetch_add(1, std::memory_order_relaxed);
   }
   if (on_episode != nullptr && *on_episode) {

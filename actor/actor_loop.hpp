@@ -4,7 +4,7 @@
 // TransitionBatches; reports every episode to the learner; picks up PolicyWeights from the
 // learner's PUB socket between steps; heartbeats and re-joins when the cluster map changes.
 //
-// Semantics follow the single-process trainer (app/trainer.cpp): the stored action is the full
+// Semantics follow the single-process trainer (app/trainer.cpp), demonstrations included: the stored action is the full
 // output vector as executed (the random draw under ε, squashed when bound = squashing), returns
 // are discounted with gamma to the episode end, and the last transition of an episode is terminal
 // (also when the episode is cut at the env's max_episode_steps()).
@@ -40,6 +40,7 @@
 
 #include "actor/exploration.hpp"
 #include "actor/learner_link.hpp"
+#include "core/policy.hpp"
 #include "core/transport.hpp"
 #include "envs/env.hpp"
 
@@ -59,6 +60,11 @@ struct ActorLoopConfig {
   int send_attempt_ms = 20;  // one blocking send attempt; control sockets are served in between
   int tick_ms = 1000;        // on_tick period
   std::optional<net::CurveClientKeys> curve;
+  // With exploration.demo_fraction > 0: makes the teacher that plays the demonstrations, one per
+  // env. An episode is a demonstration with probability demo_share(updates, demo_fraction,
+  // demo_anneal_updates), drawn at its start as `pamdp train` draws it; its transitions go to the
+  // shards like the agent's, and its EpisodeReport says `scripted` (weights version 0).
+  std::function<std::unique_ptr<Policy>()> make_teacher;
 };
 
 // Counter order in the actor's Heartbeat: env_steps, episodes, batches_sent, transitions_sent,

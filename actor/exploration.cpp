@@ -22,6 +22,19 @@ double demo_share(int64_t updates, double fraction, int64_t anneal) {
   return linear_epsilon(updates, fraction, 0.0, anneal);
 }
 
+int write_teacher_output(const ActionSpace& space, const ParamAction& a, std::span<const float> fill,
+                         std::span<float> out) {
+  const int num_actions = space.num_actions();
+  std::copy(fill.begin(), fill.end(), out.begin());
+  for (int k = 0; k < num_actions; ++k) {
+    out[static_cast<size_t>(k)] = k == a.id ? 1.0F : -1.0F;
+  }
+  for (const int p : space.actions[static_cast<size_t>(a.id)].param_indices) {
+    out[static_cast<size_t>(num_actions + p)] = a.params[static_cast<size_t>(p)];
+  }
+  return a.id;
+}
+
 double apex_epsilon(int actor_index, int num_actors, double base, double alpha) {
   if (num_actors <= 1) {
     return base;

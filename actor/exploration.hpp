@@ -48,6 +48,12 @@ struct ExplorationConfig {
 // The demonstration share after `updates` learner updates (see ExplorationConfig).
 double demo_share(int64_t updates, double fraction, int64_t anneal);
 
+// A teacher's action as the actor's output vector carries it (a demonstration's stored action, or
+// a teacher's label): score 1 for its action and -1 for the others, its parameters, and `fill`
+// (the actor's own output) for the other actions' parameters. Returns the action id.
+int write_teacher_output(const ActionSpace& space, const ParamAction& a, std::span<const float> fill,
+                         std::span<float> out);
+
 // Linear from start to end over `anneal` learner updates, then constant.
 double linear_epsilon(int64_t updates, double start, double end, int64_t anneal);
 // Ape-X per-actor fixed epsilon: eps_i = base^(1 + alpha * i / (N - 1)) (eps = base for N = 1).

@@ -93,8 +93,8 @@ bool LearnerLink::send_heartbeat(uint64_t map_version, std::span<const int64_t> 
 }
 
 bool LearnerLink::send_episode_report(uint32_t actor_id, uint64_t episode, float ret, uint32_t steps, int32_t status,
-                                      uint64_t policy_version) {
-  wire::build_episode_report(impl_->fbb, actor_id, episode, ret, steps, status, policy_version);
+                                      uint64_t policy_version, bool scripted) {
+  wire::build_episode_report(impl_->fbb, actor_id, episode, ret, steps, status, policy_version, scripted);
   return impl_->dealer.send(wire::bytes_of(impl_->fbb), 0);
 }
 

@@ -66,7 +66,7 @@ class LearnerLink {
   bool send_join_request();
   bool send_heartbeat(uint64_t map_version, std::span<const int64_t> counters);
   bool send_episode_report(uint32_t actor_id, uint64_t episode, float ret, uint32_t steps, int32_t status,
-                           uint64_t policy_version);
+                           uint64_t policy_version, bool scripted = false);
 
   enum class Received { kNothing, kClusterMap, kHeartbeat, kMalformed };
   // Takes one message from the learner without blocking. kClusterMap fills `map`; kHeartbeat

@@ -21,6 +21,7 @@
 #include "app/role_metrics.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
+#include "envs/hfo/scripted_offense.hpp"
 #include "envs/registry.hpp"
 
 namespace pamdp::app {
@@ -124,6 +125,11 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.apex_epsilon = o.apex_epsilon;
   loop_config.seed = o.seed >= 0 ? static_cast<uint64_t>(o.seed) : config.seed;
   loop_config.curve = curve;
+  if (config.exploration.demo_fraction > 0.0) {
+    // The learner's config was checked: demonstrations come with an env the scripted offense reads.
+    const hfo::ShotAim shot = config.demo_shot;
+    loop_config.make_teacher = [shot] { return std::make_unique<hfo::ScriptedOffense>(shot); };
+  }
 
   ActorMetrics actor_metrics(endpoint.registry(), counters, *envs.front());
   ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);

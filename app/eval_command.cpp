@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "app/actor_policy.hpp"
+#include "learner/greedy_policy.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"

@@ -14,6 +14,7 @@
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/registry.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/training_run.hpp"
 
 namespace pamdp::app {
 
@@ -69,22 +70,7 @@ struct MetricsConfig {
   int port = 0;
 };
 
-struct TrainLoopConfig {
-  int64_t max_updates = 3000000;
-  int64_t max_episodes = 0;  // 0 = no limit
-  double max_seconds = 0.0;  // 0 = no limit
-  double updates_per_step = 1.0;
-  int64_t eval_every_updates = 10000;  // 0 = never
-  int eval_episodes = 10;
-  // > 0: an evaluation that would beat the best is confirmed on this many other episodes
-  // before best.ckpt is replaced (app/run_logs.hpp, BestEval); 0 = take it as it is.
-  int confirm_episodes = 0;
-  double checkpoint_every_seconds = 600.0;
-  double log_every_seconds = 10.0;
-  // Warm start: a checkpoint whose networks a new run starts from (learner/checkpoint.hpp
-  // warm_start_from_checkpoint; e.g. a 1v0 agent continued against the goalie). Empty: from scratch.
-  std::string init_from;
-};
+// TrainLoopConfig (train.*) is the run lifecycle's: learner/training_run.hpp.
 
 struct ExperimentConfig {
   uint64_t seed = 1;

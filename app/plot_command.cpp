@@ -1,6 +1,6 @@
 // `pamdp plot RUN_DIR… [--out FILE.png]`: the paper's learning-curve panels (goal rate and mean
 // return against episodes, mean Q, critic loss) for one or several runs overlaid, drawn by
-// gnuplot from the runs' metrics.csv (app/run_logs.hpp). Columns are found by name, so runs
+// gnuplot from the runs' metrics.csv (learner/run_logs.hpp). Columns are found by name, so runs
 // written by `pamdp train` and by `pamdp learner` (and by older versions) mix.
 #include <unistd.h>
 

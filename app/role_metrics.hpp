@@ -119,7 +119,12 @@ class LearnerMetrics {
  public:
   LearnerMetrics(metrics::Registry& r, const Env& env, const ExplorationConfig& exploration);
   void on_update(const UpdateStats& s, int64_t updates_total) { updates_.add(s, updates_total); }
-  void on_episode(const EpisodeSummary& e) { episodes_.add(e.status, e.ret, static_cast<int>(e.steps)); }
+  // The agent's episodes; demonstrations are left out, as `pamdp train` leaves them out.
+  void on_episode(const EpisodeSummary& e) {
+    if (!e.scripted) {
+      episodes_.add(e.status, e.ret, static_cast<int>(e.steps));
+    }
+  }
   void on_tick(const LearnerCounters& c, int64_t updates_total, size_t metrics_urls);
   void on_eval(const EvalResult& e) { evals_.add(e); }
 

@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "actor/exploration.hpp"
-#include "app/actor_policy.hpp"
+#include "learner/greedy_policy.hpp"
 #include "app/env_factory.hpp"
 #include "app/progress.hpp"
 #include "app/role_metrics.hpp"
-#include "app/run_logs.hpp"
+#include "learner/run_logs.hpp"
 #include "app/run_support.hpp"
 #include "core/files.hpp"
 #include "core/log.hpp"
@@ -56,7 +56,8 @@ class Trainer {
         obs_(static_cast<size_t>(obs_dim_)),
         next_obs_(static_cast<size_t>(obs_dim_)),
         net_out_(static_cast<size_t>(width_)),
-        stored_(static_cast<size_t>(width_)) {
+        stored_(static_cast<size_t>(width_)),
+        run_(run_spec(c, o_.run_dir, exploration_, c.ddpg.demo_bc_weight > 0.0), ddpg_, *backend_, *env_, *eval_env_) {
     if (c.ddpg.demo_bc_weight > 0.0) {
       cpu_backend_ = dynamic_cast<CpuUpdateBackend*>(backend_.get());
       if (cpu_backend_ == nullptr) {
@@ -74,20 +75,28 @@ class Trainer {
   TrainSummary run();
 
  private:
-  void resume();
-  void save();
+  static RunSpec run_spec(const ExperimentConfig& c, const std::string& dir, const ExplorationConfig& exploration,
+                          bool clones) {
+    RunSpec spec;
+    spec.dir = dir;
+    spec.role = "train";
+    spec.config_toml = to_toml(c);
+    spec.seed = c.seed;
+    spec.loop = c.train;
+    spec.exploration = exploration;
+    // With cloning, metrics.csv also says how much of it the Q-filter lets through.
+    if (clones) {
+      spec.extra_metric_columns = {"bc_accepted_fraction", "bc_loss"};
+    }
+    return spec;
+  }
   void log_tick(bool force);
-  void run_eval();
-  void save_best();
   // The scripted offense's action for obs_ as an actor output (score 1 for its action, -1 for
   // the others, its parameters; the other parameters are the actor's own, net_out_).
   int demo_action(std::span<float> out);
   // A full sampled batch as the update reads it (no copy).
   [[nodiscard]] BatchView view_of(const BatchBuffers& b) const;
   [[nodiscard]] bool should_stop() const;
-  [[nodiscard]] double elapsed() const {
-    return base_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
 
   ExperimentConfig c_;
   TrainOptions o_;
@@ -120,62 +129,10 @@ class Trainer {
   EpisodeBuffer episode_;
   std::vector<float> obs_, next_obs_, net_out_, stored_;
 
-  int64_t env_steps_ = 0;
-  int64_t episodes_ = 0;
   double update_credit_ = 0.0;
-  double base_seconds_ = 0.0;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  RecentEpisodes recent_;
-  UpdateStats last_stats_;
-  EvalResult last_eval_;
-  bool have_eval_ = false;
-  int64_t next_eval_ = 0;
-  double last_checkpoint_ = 0.0;
-  double last_log_ = 0.0;
-  int64_t log_updates_ = 0;
-  int64_t log_steps_ = 0;
-  std::optional<RunLogs> logs_;
-  std::optional<BestEval> best_;
+  TrainingRun run_;  // last: built from the members above
   std::optional<ProgressBar> bar_;
 };
-
-void Trainer::resume() {
-  const std::string ck = (fs::path(o_.run_dir) / "checkpoint.ckpt").string();
-  const CheckpointMeta meta = load_checkpoint(ck, ddpg_);
-  backend_->load_from_host();
-  if (meta.rng_states.size() != 2) {
-    throw std::runtime_error("checkpoint '" + ck + "' holds " + std::to_string(meta.rng_states.size()) +
-                             " random streams; a train run writes 2");
-  }
-  explore_.rng().set_state(meta.rng_states[0]);
-  sample_rng_.set_state(meta.rng_states[1]);
-  env_steps_ = meta.env_steps;
-  episodes_ = meta.episodes;
-  update_credit_ = meta.update_credit;
-  base_seconds_ = meta.elapsed_seconds;
-  load_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
-  if (demo_replay_) {
-    load_replay_snapshot((fs::path(o_.run_dir) / "demo_replay.bin").string(), *demo_replay_);
-  }
-}
-
-void Trainer::save() {
-  CheckpointMeta meta;
-  meta.config_toml = to_toml(c_);
-  meta.env_steps = env_steps_;
-  meta.episodes = episodes_;
-  meta.elapsed_seconds = elapsed();
-  meta.update_credit = update_credit_;
-  meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
-  // Replay first: a checkpoint on disk always has a replay snapshot at least as new.
-  save_replay_snapshot((fs::path(o_.run_dir) / "replay.bin").string(), replay_);
-  if (demo_replay_) {
-    save_replay_snapshot((fs::path(o_.run_dir) / "demo_replay.bin").string(), *demo_replay_);
-  }
-  backend_->sync_to_host();
-  save_checkpoint((fs::path(o_.run_dir) / "checkpoint.ckpt").string(), ddpg_, meta);
-  last_checkpoint_ = elapsed();
-}
 
 bool Trainer::should_stop() const {
   if (o_.stop != nullptr && o_.stop->load()) {
@@ -184,105 +141,40 @@ bool Trainer::should_stop() const {
   if (ddpg_.updates() >= c_.train.max_updates) {
     return true;
   }
-  if (c_.train.max_episodes > 0 && episodes_ >= c_.train.max_episodes) {
+  if (c_.train.max_episodes > 0 && run_.episodes() >= c_.train.max_episodes) {
     return true;
   }
-  return c_.train.max_seconds > 0.0 && elapsed() >= c_.train.max_seconds;
-}
-
-void Trainer::run_eval() {
-  if (c_.train.eval_episodes <= 0) {
-    return;
-  }
-  backend_->sync_actor_to_host();
-  GreedyActorPolicy policy(ddpg_, space_, exploration_, evaluated_copy(ddpg_));
-  last_eval_ = evaluate(*eval_env_, policy, c_.train.eval_episodes, screening_seed(c_.seed, ddpg_.updates()));
-  have_eval_ = true;
-  if (o_.metrics != nullptr) {
-    o_.metrics->on_eval(last_eval_);
-  }
-  if (!best_) {
-    return;
-  }
-  std::function<EvalResult()> confirm;
-  if (c_.train.confirm_episodes > 0) {
-    confirm = [&] {
-      return evaluate(*eval_env_, policy, c_.train.confirm_episodes, confirmation_seed(c_.seed, ddpg_.updates()));
-    };
-  }
-  if (best_->offer(last_eval_, ddpg_.updates(), confirm)) {
-    save_best();
-  }
-}
-
-// The actor (with everything else) of the best greedy evaluation so far: what `pamdp eval
-// --checkpoint RUN/best.ckpt` should be given when the final policy is worse than an earlier one.
-void Trainer::save_best() {
-  CheckpointMeta meta;
-  meta.config_toml = to_toml(c_);
-  meta.env_steps = env_steps_;
-  meta.episodes = episodes_;
-  meta.elapsed_seconds = elapsed();
-  meta.update_credit = update_credit_;
-  meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
-  backend_->sync_to_host();
-  save_checkpoint((fs::path(o_.run_dir) / "best.ckpt").string(), ddpg_, meta);
+  return c_.train.max_seconds > 0.0 && run_.elapsed() >= c_.train.max_seconds;
 }
 
 void Trainer::log_tick(bool force) {
-  const double now = elapsed();
-  if (!force && now - last_log_ < c_.train.log_every_seconds) {
+  if (!force && run_.elapsed() - run_.last_row_seconds() < c_.train.log_every_seconds) {
     return;
   }
-  const double dt = std::max(1e-9, now - last_log_);
-  const double ups = static_cast<double>(ddpg_.updates() - log_updates_) / dt;
-  const double sps = static_cast<double>(env_steps_ - log_steps_) / dt;
-  last_log_ = now;
-  log_updates_ = ddpg_.updates();
-  log_steps_ = env_steps_;
-  const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
-                                    exploration_.epsilon_anneal_updates);
-  MetricsRow row;
-  row.wall_seconds = now;
-  row.updates = ddpg_.updates();
-  row.env_steps = env_steps_;
-  row.episodes = episodes_;
-  row.epsilon = eps;
-  row.success_rate_100 = recent_.success_rate();
-  row.mean_return_100 = recent_.mean_return();
-  row.mean_steps_100 = recent_.mean_steps();
-  row.critic_loss = last_stats_.critic_loss;
-  row.q_mean = last_stats_.q_mean;
-  row.updates_per_s = ups;
-  row.env_steps_per_s = sps;
-  if (have_eval_) {
-    row.eval = last_eval_;
-  }
-  const std::array<double, 2> bc{last_stats_.bc_accepted_fraction, last_stats_.bc_loss};
+  const MetricsRow row = run_.next_metrics_row();
+  const UpdateStats& last = run_.last_update();
+  const std::array<double, 2> bc{last.bc_accepted_fraction, last.bc_loss};
   // Flushes the episode log too, so a killed run keeps it up to this row.
-  logs_->metrics(row, demo_replay_ ? std::span<const double>(bc) : std::span<const double>{});
+  run_.logs().metrics(row, demo_replay_ ? std::span<const double>(bc) : std::span<const double>{});
   if (!o_.quiet) {
     if (bar_) {
       bar_->clear();
     }
+    const RecentEpisodes& recent = run_.recent();
     std::printf(
         "[%7.1fs] updates %lld | episodes %lld | success(last %zu) %.2f | return %.3f | eps %.3f | loss %.4g | Q %.3f "
-        "| "
-        "%.0f updates/s | %.0f steps/s",
-        now, static_cast<long long>(ddpg_.updates()), static_cast<long long>(episodes_), recent_.size(),
-        recent_.success_rate(), recent_.mean_return(), eps, static_cast<double>(last_stats_.critic_loss),
-        static_cast<double>(last_stats_.q_mean), ups, sps);
-    if (have_eval_) {
-      std::printf(" | eval %.2f", last_eval_.goal_rate);
+        "| %.0f updates/s | %.0f steps/s",
+        row.wall_seconds, static_cast<long long>(row.updates), static_cast<long long>(row.episodes), recent.size(),
+        recent.success_rate(), recent.mean_return(), *row.epsilon, row.critic_loss, row.q_mean, row.updates_per_s,
+        row.env_steps_per_s);
+    if (row.eval) {
+      std::printf(" | eval %.2f", row.eval->goal_rate);
     }
     std::printf("\n");
     std::fflush(stdout);
   }
 }
 
-// The scripted offense's action for obs_, written into stored_ as the actor's output vector would
-// carry it: score 1 for its action and -1 for the others, its parameters, and the actor's own
-// output (net_out_) for the parameters of the other actions. Returns the action id.
 BatchView Trainer::view_of(const BatchBuffers& b) const {
   const int B = c_.ddpg.batch_size;
   return {
@@ -296,69 +188,50 @@ BatchView Trainer::view_of(const BatchBuffers& b) const {
 }
 
 int Trainer::demo_action(std::span<float> out) {
-  const ParamAction a = demo_.act(obs_);
-  const int num_actions = space_.num_actions();
-  std::copy(net_out_.begin(), net_out_.end(), out.begin());
-  for (int k = 0; k < num_actions; ++k) {
-    out[static_cast<size_t>(k)] = k == a.id ? 1.0F : -1.0F;
-  }
-  for (const int p : space_.actions[static_cast<size_t>(a.id)].param_indices) {
-    out[static_cast<size_t>(num_actions + p)] = a.params[static_cast<size_t>(p)];
-  }
-  return a.id;
+  return write_teacher_output(space_, demo_.act(obs_), net_out_, out);
 }
 
 TrainSummary Trainer::run() {
-  fs::create_directories(o_.run_dir);
+  run_.on_eval = [this](const EvalResult& r) {
+    if (o_.metrics != nullptr) {
+      o_.metrics->on_eval(r);
+    }
+  };
+  run_.on_save = [this](CheckpointMeta& meta) {
+    meta.update_credit = update_credit_;
+    meta.rng_states = {explore_.rng().state(), sample_rng_.state()};
+  };
+  // Replay first: a checkpoint on disk always has a replay snapshot at least as new.
   const fs::path dir(o_.run_dir);
-  if (o_.resume) {
-    resume();
-  } else {
-    if (!c_.train.init_from.empty()) {
-      warm_start_from_checkpoint(c_.train.init_from, ddpg_);
-      backend_->load_from_host();
-      log::info("train: networks warm-started from {}", c_.train.init_from);
+  run_.before_checkpoint = [this, dir] {
+    save_replay_snapshot((dir / "replay.bin").string(), replay_);
+    if (demo_replay_) {
+      save_replay_snapshot((dir / "demo_replay.bin").string(), *demo_replay_);
     }
-    const std::string text = to_toml(c_);
-    write_file_atomically((dir / "config.toml").string(), text.data(), text.size());
-  }
-  if (ddpg_.averages_actor()) {
-    log::info("train: evaluations and best.ckpt play the actor average (ddpg.actor_average_tau = {})",
-              c_.ddpg.actor_average_tau);
-  }
-  std::optional<ResumePoint> resume_at;
+  };
+  const CheckpointMeta meta = run_.start(o_.resume);
   if (o_.resume) {
-    resume_at = ResumePoint{static_cast<int64_t>(ddpg_.updates()), static_cast<int64_t>(episodes_)};
-  }
-  // With cloning, metrics.csv also says how much of it the Q-filter lets through.
-  logs_.emplace(dir,
-                demo_replay_ ? std::vector<std::string>{"bc_accepted_fraction", "bc_loss"} : std::vector<std::string>{},
-                resume_at);
-  if (o_.resume) {
-    // The last-100 training rates go on from the episodes logged before the checkpoint, the
-    // scripted offense's left out as in run().
-    const std::string_view success = env_->status_name(env_->success_status());
-    for (const LoggedEpisode& e : last_logged_episodes(dir, 1000)) {
-      if (!e.scripted) {
-        recent_.add(e.ret, e.steps, e.outcome == success);
-      }
+    const std::string ck = (dir / "checkpoint.ckpt").string();
+    if (meta.rng_states.size() != 2) {
+      throw std::runtime_error("checkpoint '" + ck + "' holds " + std::to_string(meta.rng_states.size()) +
+                               " random streams; a train run writes 2");
+    }
+    explore_.rng().set_state(meta.rng_states[0]);
+    sample_rng_.set_state(meta.rng_states[1]);
+    update_credit_ = meta.update_credit;
+    load_replay_snapshot((dir / "replay.bin").string(), replay_);
+    if (demo_replay_) {
+      load_replay_snapshot((dir / "demo_replay.bin").string(), *demo_replay_);
     }
   }
-  best_.emplace(dir / "best_eval.txt");
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);
   }
-  start_ = std::chrono::steady_clock::now();
-  last_log_ = last_checkpoint_ = base_seconds_;
-  log_updates_ = ddpg_.updates();
-  log_steps_ = env_steps_;
-  const int64_t every = c_.train.eval_every_updates;
-  next_eval_ = every > 0 ? (ddpg_.updates() / every + 1) * every : INT64_MAX;
   const int num_actions = space_.num_actions();
 
   while (!should_stop()) {
     // One episode.
-    env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(episodes_)), obs_);
+    env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())), obs_);
     episode_.clear();
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
     const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
@@ -385,7 +258,7 @@ TrainSummary Trainer::run() {
       }
       ep_return += sr.reward;
       ++steps;
-      ++env_steps_;
+      run_.record_env_steps(1);
       if (o_.metrics != nullptr) {
         o_.metrics->on_step(eps);
       }
@@ -399,12 +272,12 @@ TrainSummary Trainer::run() {
         const int B = c_.ddpg.batch_size;
         if (demo_replay_ && demo_replay_->size() > 0) {
           demo_replay_->sample(sample_rng_, B, *demo_batch_);
-          last_stats_ = cpu_backend_->update(view_of(batch_), view_of(*demo_batch_));
+          run_.record_update(cpu_backend_->update(view_of(batch_), view_of(*demo_batch_)));
         } else {
-          last_stats_ = backend_->update(view_of(batch_));
+          run_.record_update(backend_->update(view_of(batch_)));
         }
         if (o_.metrics != nullptr) {
-          o_.metrics->on_update(last_stats_, ddpg_.updates(), B);
+          o_.metrics->on_update(run_.last_update(), ddpg_.updates(), B);
         }
         update_credit_ -= 1.0;
         if (ddpg_.updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {
@@ -422,52 +295,35 @@ TrainSummary Trainer::run() {
       flush_episode(*labelled_, c_.ddpg.gamma, *demo_replay_);
     }
     backend_->sync_actor_to_host();
-    ++episodes_;
-    const bool success = sr.status == env_->success_status();
-    if (!demo) {  // the training rates are the agent's own
-      recent_.add(ep_return, steps, success);
-    }
     if (o_.metrics != nullptr) {
       o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()), !demo);
     }
-    EpisodeRow ep;
-    ep.episode = episodes_;
-    ep.wall_seconds = elapsed();
-    ep.updates = ddpg_.updates();
-    ep.ret = ep_return;
-    ep.steps = steps;
-    ep.outcome = env_->status_name(sr.status);
     // One process: always the newest weights; none (0) for an episode the scripted offense played.
-    ep.weights_version = demo ? 0 : static_cast<uint64_t>(ddpg_.updates());
-    ep.scripted = demo;
-    logs_->episode(ep);
+    run_.record_episode({sr.status, ep_return, steps, 0, demo ? 0 : static_cast<uint64_t>(ddpg_.updates()), demo});
     if (bar_) {
       bar_->update(ddpg_.updates());
     }
-    if (ddpg_.updates() >= next_eval_) {
-      run_eval();
-      next_eval_ += c_.train.eval_every_updates;
+    if (run_.evaluate_if_due()) {
       log_tick(true);
     }
-    if (c_.train.checkpoint_every_seconds > 0.0 && elapsed() - last_checkpoint_ >= c_.train.checkpoint_every_seconds) {
-      save();
+    if (run_.checkpoint_due()) {
+      run_.save();
     }
   }
-  save();
+  run_.finish();
   if (bar_) {
     bar_->finish();
   }
-  logs_->flush();
   TrainSummary s;
-  run_eval();
-  if (have_eval_) {
-    s.final_eval = last_eval_;
+  run_.evaluate();
+  if (run_.last_eval()) {
+    s.final_eval = *run_.last_eval();
   }
   log_tick(true);
   s.updates = ddpg_.updates();
-  s.env_steps = env_steps_;
-  s.episodes = episodes_;
-  s.seconds = elapsed();
+  s.env_steps = run_.env_steps();
+  s.episodes = run_.episodes();
+  s.seconds = run_.elapsed();
   return s;
 }
 

@@ -143,10 +143,11 @@ void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version,
 }
 
 void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,
-                          uint32_t steps, int32_t status, uint64_t policy_version) {
+                          uint32_t steps, int32_t status, uint64_t policy_version, bool scripted) {
   fbb.Clear();
   finish(fbb, Payload::EpisodeReport,
-         CreateEpisodeReport(fbb, kSchemaVersion, actor_id, episode, ret, steps, status, policy_version).Union());
+         CreateEpisodeReport(fbb, kSchemaVersion, actor_id, episode, ret, steps, status, policy_version, scripted)
+             .Union());
 }
 
 void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,

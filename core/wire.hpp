@@ -59,7 +59,7 @@ void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id
 void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
                           std::span<const int> widths, uint8_t bound, std::span<const float> params);
 void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,
-                          uint32_t steps, int32_t status, uint64_t policy_version);
+                          uint32_t steps, int32_t status, uint64_t policy_version, bool scripted = false);
 void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,
                      std::span<const int64_t> counters);
 void build_metrics_urls_request(flatbuffers::FlatBufferBuilder& fbb);

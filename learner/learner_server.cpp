@@ -185,7 +185,7 @@ void LearnerServer::handle_join_socket() {
         }
         ++counters_.episodes;
         if (on_episode) {
-          on_episode({r->actor_id(), r->return_(), r->steps(), r->status(), r->policy_version()});
+          on_episode({r->actor_id(), r->return_(), r->steps(), r->status(), r->policy_version(), r->scripted()});
         }
         break;
       }

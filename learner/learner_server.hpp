@@ -65,6 +65,7 @@ struct EpisodeSummary {
   uint32_t steps;
   int32_t status;
   uint64_t policy_version;  // weights version the actor played the episode with
+  bool scripted = false;    // a demonstration: the teacher played it
 };
 
 class LearnerServer {

@@ -60,6 +60,7 @@ struct ReportCopy {
   uint32_t steps = 0;
   int32_t status = 0;
   uint64_t policy_version = 0;
+  bool scripted = false;
 };
 
 struct JoinCopy {
@@ -164,7 +165,7 @@ class FakeLearner {
         }
         case wire::Payload::EpisodeReport: {
           const auto* r = env->payload_as_EpisodeReport();
-          reports.push_back({r->actor_id(), r->episode(), r->return_(), r->steps(), r->status(), r->policy_version()});
+          reports.push_back({r->actor_id(), r->episode(), r->return_(), r->steps(), r->status(), r->policy_version(), r->scripted()});
           break;
         }
         default: ADD_FAILURE() << "unexpected message type from the actor";

@@ -148,6 +148,70 @@ TEST(ActorLoop, JoinsAndShipsTransitionsWithMonteCarloReturnsAndEpisodeReports) 
   EXPECT_EQ(learner.last_heartbeat_counters[3], 64 * learner.last_heartbeat_counters[2]);  // transitions_sent
 }
 
+// A teacher that always moves at velocity 0.25: its ReachStop episodes run to the time limit.
+class SlowMover final : public Policy {
+ public:
+  void begin_episode() override { ++episodes; }
+  ParamAction act(std::span<const float> /*obs*/) override { return {toy::ReachStopEnv::kMove, params_}; }
+  int episodes = 0;
+
+ private:
+  std::array<float, 1> params_{0.25F};
+};
+
+TEST(ActorLoop, PlaysDemonstrationsAndReportsThemAsScripted) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorLoopConfig config = test_loop_config();
+  config.exploration.demo_fraction = 0.5;
+  config.make_teacher = [] { return std::make_unique<SlowMover>(); };
+  ActorRunner actor(ctx, learner.join_endpoint(), config, /*envs=*/1);
+  ASSERT_TRUE(
+      serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 40 && learner.reports.size() >= 60; }));
+
+  const BatchCopy rows = concat(shard.batches);
+  std::vector<std::pair<size_t, size_t>> episodes;
+  size_t begin = 0;
+  for (size_t t = 0; t < rows.count; ++t) {
+    if (rows.terminals[t] != 0) {
+      episodes.emplace_back(begin, t + 1);
+      begin = t + 1;
+    }
+  }
+  // The teacher's rows: MOVE scored 1, STOP -1, its velocity.
+  auto teachers_row = [&](size_t t) {
+    return rows.actions[t * kWidth] == 1.0F && rows.actions[t * kWidth + 1] == -1.0F &&
+           rows.actions[t * kWidth + 2] == 0.25F;
+  };
+  int scripted = 0;
+  int agent = 0;
+  for (const ReportCopy& r : learner.reports) {
+    if (r.episode > episodes.size()) {
+      break;
+    }
+    const auto [b, e] = episodes[r.episode - 1];
+    bool all_teachers = true;
+    for (size_t t = b; t < e; ++t) {
+      all_teachers = all_teachers && teachers_row(t);
+    }
+    if (r.scripted) {
+      ++scripted;
+      EXPECT_TRUE(all_teachers) << "episode " << r.episode;
+      EXPECT_EQ(r.steps, 20U);  // moving never ends an episode before the limit
+      EXPECT_EQ(r.status, toy::ReachStopEnv::kOutOfTime);
+      EXPECT_EQ(r.policy_version, 0U);
+    } else {
+      ++agent;
+      EXPECT_FALSE(all_teachers) << "episode " << r.episode;
+    }
+  }
+  // Half the episodes, drawn: both kinds, in about equal numbers.
+  EXPECT_GE(scripted, 10);
+  EXPECT_GE(agent, 10);
+}
+
 TEST(ActorLoop, AppliesPublishedWeightsAndActsWithThem) {
   net::Context ctx;
   FakeLearner learner(ctx);

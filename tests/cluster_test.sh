@@ -146,7 +146,7 @@ wait "${pids[0]}" || fail "the learner exited with an error"
 
 metrics=$work/run/metrics.csv
 [[ -f $metrics ]] || fail "no metrics.csv"
-# Columns by name (app/run_logs.hpp), from the last row.
+# Columns by name (learner/run_logs.hpp), from the last row.
 column() {
   awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i } END { if (c) print $c }' "$metrics"
 }

@@ -1,6 +1,6 @@
-// The run directory's CSV files (app/run_logs), the best-evaluation keeper, the progress bar's
+// The run directory's CSV files (learner/run_logs), the best-evaluation keeper, the progress bar's
 // formatting, and `pamdp plot` on a real run directory written by `pamdp train`.
-#include "app/run_logs.hpp"
+#include "learner/run_logs.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

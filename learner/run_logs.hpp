@@ -37,7 +37,7 @@
 
 #include "learner/evaluation.hpp"
 
-namespace pamdp::app {
+namespace pamdp {
 
 struct MetricsRow {
   double wall_seconds = 0.0;
@@ -153,4 +153,4 @@ class BestEval {
   std::optional<EvalResult> best_;
 };
 
-}  // namespace pamdp::app
+}  // namespace pamdp

@@ -9,7 +9,7 @@
 #include "core/policy.hpp"
 #include "learner/ddpg.hpp"
 
-namespace pamdp::app {
+namespace pamdp {
 
 class GreedyActorPolicy final : public Policy {
  public:
@@ -41,4 +41,4 @@ inline ActorCopy evaluated_copy(const Ddpg& ddpg) {
   return ddpg.averages_actor() ? ActorCopy::kAverage : ActorCopy::kOnline;
 }
 
-}  // namespace pamdp::app
+}  // namespace pamdp

@@ -1,4 +1,4 @@
-#include "app/run_logs.hpp"
+#include "learner/run_logs.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -13,7 +13,7 @@
 #include "core/files.hpp"
 #include "core/log.hpp"
 
-namespace pamdp::app {
+namespace pamdp {
 namespace fs = std::filesystem;
 
 namespace {
@@ -339,4 +339,4 @@ bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<E
   return true;
 }
 
-}  // namespace pamdp::app
+}  // namespace pamdp
