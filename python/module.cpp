@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "actor/exploration.hpp"
-#include "app/actor_policy.hpp"
+#include "learner/greedy_policy.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "learner/checkpoint.hpp"
@@ -470,7 +470,7 @@ class PyPolicy {
         explore_(explore) {
     load_checkpoint(path, ddpg_);
     if (actor == "evaluated") {
-      copy_ = app::evaluated_copy(ddpg_);
+      copy_ = evaluated_copy(ddpg_);
     } else if (actor == "online") {
       copy_ = ActorCopy::kOnline;
     } else if (actor == "target") {
