@@ -94,6 +94,9 @@ struct EnvSlot {
   EpisodeBuffer episode;
   std::unique_ptr<Policy> teacher;  // with demonstrations
   bool demo = false;                // this episode is the teacher's
+  bool label = false;               // the agent's episode, labelled by the teacher (demo_relabel)
+  std::optional<EpisodeBuffer> labelled;
+  std::vector<float> label_output;  // the teacher's label as an output vector
   uint64_t seed = 0;
   uint64_t episodes = 0;
   double ret = 0.0;
@@ -146,6 +149,9 @@ ActorLoopConfig checked(ActorLoopConfig c) {
   if (c.exploration.demo_fraction > 0.0 && !c.make_teacher) {
     throw std::invalid_argument("ActorLoop: exploration.demo_fraction > 0 needs a teacher (make_teacher)");
   }
+  if (c.exploration.demo_relabel && !(c.demo_table && c.make_teacher)) {
+    throw std::invalid_argument("ActorLoop: exploration.demo_relabel needs the demonstration table and a teacher");
+  }
   if (c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 || c.send_attempt_ms < 1 || c.tick_ms < 1 || c.shard_send_hwm < 1) {
     throw std::invalid_argument(
         "ActorLoop: heartbeat_ms, peer_timeout_ms, send_attempt_ms, tick_ms and shard_send_hwm must be positive");
@@ -167,8 +173,9 @@ struct ActorLoop::Impl {
   void finish_episode(EnvSlot& slot, int status);
   void reset(EnvSlot& slot);
 
-  void send_batch();
-  bool try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms);
+  void send_batch(OutgoingBatch& b, uint8_t table);
+  void add_rows(EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table);
+  bool try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms, OutgoingBatch& b);
   Shard* pick_shard(Clock::time_point now);
   [[nodiscard]] bool another_available(size_t index, Clock::time_point now) const;
   void final_flush();
@@ -222,6 +229,7 @@ struct ActorLoop::Impl {
 
   // Sending.
   OutgoingBatch batch;
+  std::optional<OutgoingBatch> demo_batch;  // for the demonstration table (config.demo_table)
   flatbuffers::FlatBufferBuilder batch_fbb;
   uint64_t sequence = 0;
 
@@ -262,6 +270,13 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
     if (config.make_teacher) {
       envs.back().teacher = config.make_teacher();
     }
+    if (config.exploration.demo_relabel) {
+      envs.back().labelled.emplace(envs.back().env->max_episode_steps(), obs_dim, width);
+      envs.back().label_output.resize(static_cast<size_t>(width));
+    }
+  }
+  if (config.demo_table) {
+    demo_batch.emplace(config.batch_transitions, obs_dim, width);
   }
   sub.set_max_message_bytes(kMaxWeightsBytes);
   sub.set_recv_hwm(4);  // only the newest weights matter
@@ -318,7 +333,11 @@ void ActorLoop::Impl::reset(EnvSlot& slot) {
   const ExplorationConfig& x = config.exploration;
   const double share = demo_share(updates, x.demo_fraction, x.demo_anneal_updates);
   slot.demo = share > 0.0 && explore.rng().uniform() < share;
-  if (slot.demo) {
+  slot.label = slot.labelled.has_value() && !slot.demo;  // the agent plays, the teacher labels
+  if (slot.label) {
+    slot.labelled->clear();
+  }
+  if (slot.demo || slot.label) {
     slot.teacher->begin_episode();
   }
 }
@@ -330,14 +349,20 @@ void ActorLoop::Impl::forward(std::span<const float> obs) {
 void ActorLoop::Impl::step(EnvSlot& slot) {
   // At ε = 1 the network's output is never used, so it is not computed (a demonstration stores it
   // as the parameters of the actions the teacher did not take).
-  if (policy != nullptr && (eps < 1.0 || slot.demo)) {
+  if (policy != nullptr && (eps < 1.0 || slot.demo || slot.label)) {
     forward(slot.obs);
   }
   const int id = slot.demo ? write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.stored)
                            : explore.select(net_out, eps, slot.stored);
+  if (slot.label) {  // before the step: the label is for the state the agent acted in
+    write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.label_output);
+  }
   const StepResult sr = slot.env->step(
       {id, std::span<const float>(slot.stored).subspan(static_cast<size_t>(num_actions))}, slot.next_obs);
   slot.episode.push(slot.obs, slot.stored, sr.reward, slot.next_obs);
+  if (slot.label) {
+    slot.labelled->push(slot.obs, slot.label_output, sr.reward, slot.next_obs);
+  }
   slot.ret += sr.reward;
   ++slot.steps;
   std::swap(slot.obs, slot.next_obs);
@@ -348,14 +373,13 @@ void ActorLoop::Impl::step(EnvSlot& slot) {
 }
 
 void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
-  EpisodeBuffer& ep = slot.episode;
-  ep.compute_returns(config.gamma);
   // The last step is terminal, time-outs included, as in the paper's code and `pamdp train`.
-  for (size_t i = 0; i < ep.size(); ++i) {
-    batch.append(ep.transition(i));
-    if (batch.full()) {
-      send_batch();
-    }
+  add_rows(slot.episode, batch, wire::kReplayTable);
+  if (slot.demo && demo_batch) {
+    add_rows(slot.episode, *demo_batch, wire::kDemoTable);
+  }
+  if (slot.label) {
+    add_rows(*slot.labelled, *demo_batch, wire::kDemoTable);
   }
   ++slot.episodes;
   const int64_t episode = counters.episodes.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -394,7 +418,7 @@ bool ActorLoop::Impl::another_available(size_t index, Clock::time_point now) con
 }
 
 // One send attempt to shards[index]; on success the batch is gone and the rotation moves on.
-bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms) {
+bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms, OutgoingBatch& b) {
   Shard& s = shards[index];
   if (!s.dealer.send(bytes, timeout_ms)) {
     return false;
@@ -407,15 +431,25 @@ bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int
   next_shard = (index + 1) % shards.size();
   ++sequence;
   counters.batches_sent.fetch_add(1, std::memory_order_relaxed);
-  counters.transitions_sent.fetch_add(batch.rows().count, std::memory_order_relaxed);
-  batch.clear();
+  counters.transitions_sent.fetch_add(b.rows().count, std::memory_order_relaxed);
+  b.clear();
   return true;
 }
 
 // Blocks (serving the control sockets) until a shard takes the batch or stop is set, in which
 // case the batch is dropped.
-void ActorLoop::Impl::send_batch() {
-  wire::build_transition_batch(batch_fbb, actor_index, sequence, batch.rows());
+void ActorLoop::Impl::add_rows(EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table) {
+  ep.compute_returns(config.gamma);
+  for (size_t i = 0; i < ep.size(); ++i) {
+    b.append(ep.transition(i));
+    if (b.full()) {
+      send_batch(b, table);
+    }
+  }
+}
+
+void ActorLoop::Impl::send_batch(OutgoingBatch& b, uint8_t table) {
+  wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table);
   const std::span<const uint8_t> bytes = wire::bytes_of(batch_fbb);
   while (!stop->load(std::memory_order_relaxed)) {
     const auto now = Clock::now();
@@ -426,7 +460,7 @@ void ActorLoop::Impl::send_batch() {
     if (target == nullptr) {
       // No shard in the map, or every one skipped: probe the skipped ones, then wait a slice.
       for (size_t j = 0; j < shards.size(); ++j) {
-        if (try_send((next_shard + j) % shards.size(), bytes, 0)) {
+        if (try_send((next_shard + j) % shards.size(), bytes, 0, b)) {
           return;
         }
       }
@@ -440,7 +474,7 @@ void ActorLoop::Impl::send_batch() {
     }
     const size_t index = next_shard;
     const bool probing = target->skipped_until.has_value();
-    if (try_send(index, bytes, probing ? 0 : config.send_attempt_ms)) {
+    if (try_send(index, bytes, probing ? 0 : config.send_attempt_ms, b)) {
       return;
     }
     const auto after = Clock::now();
@@ -463,20 +497,26 @@ void ActorLoop::Impl::send_batch() {
       next_shard = (index + 1) % shards.size();
     }
   }
-  batch.clear();
+  b.clear();
 }
 
 void ActorLoop::Impl::final_flush() {
-  if (batch.empty()) {
-    return;
-  }
-  wire::build_transition_batch(batch_fbb, actor_index, sequence, batch.rows());
-  for (size_t j = 0; j < shards.size(); ++j) {
-    if (try_send((next_shard + j) % shards.size(), wire::bytes_of(batch_fbb), config.send_attempt_ms)) {
+  const auto flush = [&](OutgoingBatch& b, uint8_t table) {
+    if (b.empty()) {
       return;
     }
+    wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table);
+    for (size_t j = 0; j < shards.size(); ++j) {
+      if (try_send((next_shard + j) % shards.size(), wire::bytes_of(batch_fbb), config.send_attempt_ms, b)) {
+        return;
+      }
+    }
+    b.clear();
+  };
+  flush(batch, wire::kReplayTable);
+  if (demo_batch) {
+    flush(*demo_batch, wire::kDemoTable);
   }
-  batch.clear();
 }
 
 // ---------------------------------------------------------------------------------------------

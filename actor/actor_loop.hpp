@@ -65,6 +65,11 @@ struct ActorLoopConfig {
   // demo_anneal_updates), drawn at its start as `pamdp train` draws it; its transitions go to the
   // shards like the agent's, and its EpisodeReport says `scripted` (weights version 0).
   std::function<std::unique_ptr<Policy>()> make_teacher;
+  // Cloning (ddpg.demo_bc_weight > 0): a demonstration's rows also go to the shards'
+  // demonstration table (TransitionBatch.table = 1), as `pamdp train` keeps them in a second
+  // buffer; with exploration.demo_relabel, the agent's own steps go there too, each labelled with
+  // the teacher's action for the same state.
+  bool demo_table = false;
 };
 
 // Counter order in the actor's Heartbeat: env_steps, episodes, batches_sent, transitions_sent,

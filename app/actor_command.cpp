@@ -130,6 +130,7 @@ void run_actor(const ActorCliOptions& o) {
     const hfo::ShotAim shot = config.demo_shot;
     loop_config.make_teacher = [shot] { return std::make_unique<hfo::ScriptedOffense>(shot); };
   }
+  loop_config.demo_table = config.ddpg.demo_bc_weight > 0.0;
 
   ActorMetrics actor_metrics(endpoint.registry(), counters, *envs.front());
   ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);

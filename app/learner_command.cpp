@@ -1,5 +1,6 @@
 // `pamdp learner`: the learner process of the distributed system (docs/protocol.md).
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -72,14 +73,6 @@ void run_learner(const LearnerCliOptions& o) {
       throw std::runtime_error("run directory '" + run_dir + "' already holds a run; use --resume " + run_dir);
     }
   }
-  if (c.ddpg.demo_bc_weight > 0.0) {
-    throw std::runtime_error(
-        "ddpg.demo_bc_weight = " + std::to_string(c.ddpg.demo_bc_weight) +
-        ": cloning demonstrations runs in pamdp train only; the cluster's actors play demonstrations "
-        "(exploration.demo_fraction) into the replay shards, but the shards keep no separate demonstration "
-        "table to clone from. Set ddpg.demo_bc_weight = 0 (--set ddpg.demo_bc_weight=0 --set "
-        "exploration.demo_relabel=false) or train with pamdp train");
-  }
   // Before anything is written or bound: no cluster socket on the network without CURVE unless
   // asked for.
   const SecurityOptions security{
@@ -107,6 +100,11 @@ void run_learner(const LearnerCliOptions& o) {
   spec.exploration = exploration;
   spec.extra_metric_columns = {"samples_per_s",     "shards",           "actors_joined", "weights_version",
                                "malformed_messages", "waiting_for_data_ms"};
+  // With cloning, metrics.csv also says how much of it the Q-filter lets through (as train's).
+  const bool clones = c.ddpg.demo_bc_weight > 0.0;
+  if (clones) {
+    spec.extra_metric_columns.insert(spec.extra_metric_columns.end(), {"bc_accepted_fraction", "bc_loss"});
+  }
   // Actors played the episodes reported after the last checkpoint, and their transitions are in
   // the replay shards: their rows stay, and the next episodes are numbered after them.
   spec.keeps_episodes_after_checkpoint = true;
@@ -125,6 +123,7 @@ void run_learner(const LearnerCliOptions& o) {
   sc.max_updates = c.train.max_updates;
   sc.max_seconds = c.train.max_seconds;
   sc.weights_version = meta.weights_version;
+  sc.clone_demos = clones;
   o.apply_metrics_overrides(c);
   MetricsEndpoint endpoint("learner", "learner", c.metrics.bind, c.metrics.port, c.cluster.advertise_host);
   LearnerMetrics learner_metrics(endpoint.registry(), *env, exploration);
@@ -171,13 +170,16 @@ void run_learner(const LearnerCliOptions& o) {
     const MetricsRow row = run.next_metrics_row();
     const double sps = static_cast<double>(k.samples_received - last_samples) / dt;
     last_samples = k.samples_received;
-    const double extras[] = {sps,
-                             static_cast<double>(k.shards),
-                             static_cast<double>(k.actors_joined),
-                             static_cast<double>(k.weights_version),
-                             static_cast<double>(k.malformed_messages),
-                             static_cast<double>(k.waiting_for_data_ms)};
-    run.logs().metrics(row, extras);
+    const UpdateStats& last = run.last_update();
+    const std::array<double, 8> extras{sps,
+                                       static_cast<double>(k.shards),
+                                       static_cast<double>(k.actors_joined),
+                                       static_cast<double>(k.weights_version),
+                                       static_cast<double>(k.malformed_messages),
+                                       static_cast<double>(k.waiting_for_data_ms),
+                                       last.bc_accepted_fraction,
+                                       last.bc_loss};
+    run.logs().metrics(row, std::span<const double>(extras).first(clones ? 8 : 6));
     if (!o.quiet && row.wall_seconds - last_print >= c.train.log_every_seconds) {
       last_print = row.wall_seconds;
       const RecentEpisodes& recent = run.recent();

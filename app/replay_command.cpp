@@ -130,6 +130,9 @@ ShardConfig shard_config_from_experiment(const ExperimentConfig& config) {
                              " split over replay.shards " + std::to_string(shards) +
                              " leaves no room per shard; raise replay.capacity");
   }
+  // Cloning keeps the demonstrations in a table of their own, as `pamdp train` keeps them in a
+  // second buffer of the same capacity.
+  s.demo_capacity = config.ddpg.demo_bc_weight > 0.0 ? s.capacity : 0;
   const std::unique_ptr<Env> env = make_env(config.env);
   s.obs_dim = env->observation_size();
   s.action_dim = env->action_space().output_width();

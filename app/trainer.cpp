@@ -59,10 +59,6 @@ class Trainer {
         stored_(static_cast<size_t>(width_)),
         run_(run_spec(c, o_.run_dir, exploration_, c.ddpg.demo_bc_weight > 0.0), ddpg_, *backend_, *env_, *eval_env_) {
     if (c.ddpg.demo_bc_weight > 0.0) {
-      cpu_backend_ = dynamic_cast<CpuUpdateBackend*>(backend_.get());
-      if (cpu_backend_ == nullptr) {
-        throw std::logic_error("train: cloning demonstrations needs the CPU update backend");
-      }
       demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
       demo_batch_.emplace(obs_dim_, width_, c.ddpg.batch_size);
       if (c.exploration.demo_relabel) {
@@ -114,14 +110,13 @@ class Trainer {
   std::unique_ptr<UpdateBackend> backend_;
   ReplayBuffer replay_;
   // With ddpg.demo_bc_weight > 0: the demonstrated transitions again, kept for cloning (they
-  // also go into replay_), and the backend, which is then the CPU one.
+  // also go into replay_); the backend is then the CPU one (make_update_backend).
   std::optional<ReplayBuffer> demo_replay_;
   std::optional<BatchBuffers> demo_batch_;
   // With exploration.demo_relabel: the agent's steps of the running episode with the scripted
   // offense's action in place of the agent's, flushed into demo_replay_ at its end.
   std::optional<EpisodeBuffer> labelled_;
   std::vector<float> label_;
-  CpuUpdateBackend* cpu_backend_ = nullptr;
   EpsilonGreedy explore_;
   hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
   Rng sample_rng_;
@@ -272,7 +267,7 @@ TrainSummary Trainer::run() {
         const int B = c_.ddpg.batch_size;
         if (demo_replay_ && demo_replay_->size() > 0) {
           demo_replay_->sample(sample_rng_, B, *demo_batch_);
-          run_.record_update(cpu_backend_->update(view_of(batch_), view_of(*demo_batch_)));
+          run_.record_update(backend_->update(view_of(batch_), view_of(*demo_batch_)));
         } else {
           run_.record_update(backend_->update(view_of(batch_)));
         }

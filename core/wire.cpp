@@ -23,7 +23,7 @@ bool all_finite(const flatbuffers::Vector<float>* v) {
 }
 
 flatbuffers::Offset<TransitionBatch> batch_offset(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id,
-                                                  uint64_t sequence, const TransitionRows& r) {
+                                                  uint64_t sequence, const TransitionRows& r, uint8_t table = 0) {
   const size_t n = r.count;
   const auto states = fbb.CreateVector(r.states, n * r.obs_dim);
   const auto actions = fbb.CreateVector(r.actions, n * r.action_dim);
@@ -32,7 +32,7 @@ flatbuffers::Offset<TransitionBatch> batch_offset(flatbuffers::FlatBufferBuilder
   const auto terminals = fbb.CreateVector(r.terminals, n);
   const auto returns = fbb.CreateVector(r.mc_returns, n);
   return CreateTransitionBatch(fbb, actor_id, sequence, r.obs_dim, r.action_dim, r.count, states, actions, rewards,
-                               next_states, terminals, returns);
+                               next_states, terminals, returns, table);
 }
 
 }  // namespace
@@ -118,20 +118,26 @@ void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, co
 }
 
 void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
-                            const TransitionRows& rows) {
+                            const TransitionRows& rows, uint8_t table) {
   fbb.Clear();
-  finish(fbb, Payload::TransitionBatch, batch_offset(fbb, actor_id, sequence, rows).Union());
+  finish(fbb, Payload::TransitionBatch, batch_offset(fbb, actor_id, sequence, rows, table).Union());
 }
 
-void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size) {
+void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size,
+                          uint32_t demo_batch_size) {
   fbb.Clear();
-  finish(fbb, Payload::SampleRequest, CreateSampleRequest(fbb, request_id, batch_size).Union());
+  finish(fbb, Payload::SampleRequest, CreateSampleRequest(fbb, request_id, batch_size, demo_batch_size).Union());
 }
 
-void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows) {
+void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows,
+                        const TransitionRows* demos) {
   fbb.Clear();
   const auto batch = batch_offset(fbb, 0, request_id, rows);
-  finish(fbb, Payload::SampleReply, CreateSampleReply(fbb, request_id, batch).Union());
+  flatbuffers::Offset<TransitionBatch> demo_batch;
+  if (demos != nullptr) {
+    demo_batch = batch_offset(fbb, 0, request_id, *demos, kDemoTable);
+  }
+  finish(fbb, Payload::SampleReply, CreateSampleReply(fbb, request_id, batch, demo_batch).Union());
 }
 
 void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,

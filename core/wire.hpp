@@ -52,10 +52,17 @@ void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, co
                        const std::vector<std::string>& shard_insert_endpoints,
                        const std::vector<std::string>& shard_sample_endpoints, const std::string& weights_endpoint,
                        uint32_t actor_index, uint32_t num_actors_hint, uint64_t weights_version);
+// TransitionBatch.table: the replay table, and the demonstration table that cloning samples.
+inline constexpr uint8_t kReplayTable = 0;
+inline constexpr uint8_t kDemoTable = 1;
+
 void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
-                            const TransitionRows& rows);
-void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size);
-void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows);
+                            const TransitionRows& rows, uint8_t table = kReplayTable);
+// demo_batch_size > 0: the shard also sends that many demonstrations when it holds any.
+void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size,
+                          uint32_t demo_batch_size = 0);
+void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows,
+                        const TransitionRows* demos = nullptr);
 void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
                           std::span<const int> widths, uint8_t bound, std::span<const float> params);
 void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,

@@ -228,13 +228,32 @@ void LearnerServer::refresh_peers(bool drop_silent) {
 
 void LearnerServer::request_samples(Shard& shard) {
   while (shard.in_flight < config_.requests_in_flight_per_shard) {
-    wire::build_sample_request(fbb_->fbb, next_request_id_++, static_cast<uint32_t>(ddpg_.config().batch_size));
+    const auto B = static_cast<uint32_t>(ddpg_.config().batch_size);
+    wire::build_sample_request(fbb_->fbb, next_request_id_++, B, config_.clone_demos ? B : 0);
     if (!shard.dealer.send(wire::bytes_of(fbb_->fbb), 0)) {
       return;
     }
     ++shard.in_flight;
   }
 }
+
+namespace {
+// A validated batch as the update reads it; `terminal` receives the 0/1 flags as floats.
+BatchView view_of(const wire::TransitionRows& rows, std::vector<float>& terminal) {
+  const auto B = static_cast<Eigen::Index>(rows.count);
+  for (uint32_t i = 0; i < rows.count; ++i) {
+    terminal[i] = rows.terminals[i] != 0 ? 1.0F : 0.0F;
+  }
+  return {
+      Eigen::Map<const Eigen::MatrixXf>(rows.states, rows.obs_dim, B),
+      Eigen::Map<const Eigen::MatrixXf>(rows.actions, rows.action_dim, B),
+      Eigen::Map<const Eigen::VectorXf>(rows.rewards, B),
+      Eigen::Map<const Eigen::MatrixXf>(rows.next_states, rows.obs_dim, B),
+      Eigen::Map<const Eigen::VectorXf>(terminal.data(), B),
+      Eigen::Map<const Eigen::VectorXf>(rows.mc_returns, B),
+  };
+}
+}  // namespace
 
 void LearnerServer::handle_shard(Shard& shard) {
   net::Message& msg = reply_;  // reused: its aligned copy buffer grows once
@@ -257,21 +276,21 @@ void LearnerServer::handle_shard(Shard& shard) {
       note_malformed("SampleReply with wrong sizes");
       return;
     }
+    const wire::TransitionBatch* d = config_.clone_demos ? env->payload_as_SampleReply()->demos() : nullptr;
+    if (d != nullptr && (!wire::valid_batch(d, obs, act, static_cast<uint32_t>(B)) || d->count() != static_cast<uint32_t>(B))) {
+      note_malformed("SampleReply with demonstrations of wrong sizes");
+      return;
+    }
     // Ask for the next batch before updating, so the shard works while we do.
     request_samples(shard);
-    const wire::TransitionRows rows = wire::rows_of(b);
-    for (int i = 0; i < B; ++i) {
-      terminal[static_cast<size_t>(i)] = rows.terminals[i] != 0 ? 1.0F : 0.0F;
+    const BatchView view = view_of(wire::rows_of(b), terminal);
+    UpdateStats stats;
+    if (d != nullptr) {
+      stats = backend_.update(view, view_of(wire::rows_of(d), demo_terminal_scratch_));
+      counters_.demo_samples_received += B;
+    } else {
+      stats = backend_.update(view);
     }
-    const BatchView view{
-        Eigen::Map<const Eigen::MatrixXf>(rows.states, obs, B),
-        Eigen::Map<const Eigen::MatrixXf>(rows.actions, act, B),
-        Eigen::Map<const Eigen::VectorXf>(rows.rewards, B),
-        Eigen::Map<const Eigen::MatrixXf>(rows.next_states, obs, B),
-        Eigen::Map<const Eigen::VectorXf>(terminal.data(), B),
-        Eigen::Map<const Eigen::VectorXf>(rows.mc_returns, B),
-    };
-    const UpdateStats stats = backend_.update(view);
     ++counters_.updates;
     counters_.samples_received += B;
     shard.samples += B;
@@ -309,6 +328,7 @@ void LearnerServer::shards_changed() {
 
 void LearnerServer::run() {
   terminal_scratch_.assign(static_cast<size_t>(ddpg_.config().batch_size), 0.0F);
+  demo_terminal_scratch_.assign(static_cast<size_t>(ddpg_.config().batch_size), 0.0F);
   const auto start = Clock::now();
   auto last_tick = start;
   auto waiting_since = Clock::now();

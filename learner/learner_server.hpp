@@ -43,11 +43,16 @@ struct LearnerServerConfig {
   std::optional<net::CurveServerKeys> curve;         // CURVE on both bound sockets when set
   std::optional<net::CurveClientKeys> curve_client;  // for the learner's own connections to shards
   int64_t weights_version = 0;                       // last version published (a resumed run goes on from it)
+  // Cloning (ddpg.demo_bc_weight > 0): every sample request also asks for a batch from the
+  // shards' demonstration table, and an update whose reply carries one clones it
+  // (UpdateBackend::update(batch, demos)); until a shard holds demonstrations, plain updates.
+  bool clone_demos = false;
 };
 
 struct LearnerCounters {
   int64_t updates = 0;
   int64_t samples_received = 0;
+  int64_t demo_samples_received = 0;  // demonstrations cloned (clone_demos)
   int64_t malformed_messages = 0;
   int64_t episodes = 0;
   int64_t weights_version = 0;
@@ -139,6 +144,7 @@ class LearnerServer {
   std::unique_ptr<FbbHolder> fbb_;
   int64_t last_published_at_ = -1;
   std::vector<float> terminal_scratch_;
+  std::vector<float> demo_terminal_scratch_;
   net::Message reply_;
   std::optional<std::chrono::steady_clock::time_point> republish_at_;
   std::map<std::string, Peer> peers_;  // by join-socket identity (bytes)

@@ -17,6 +17,11 @@ const char* update_device_name(UpdateDevice device) {
   return "?";
 }
 
+UpdateStats UpdateBackend::update(const BatchView& /*batch*/, const BatchView& /*demos*/) {
+  throw std::logic_error(std::string("the ") + name() +
+                         " update backend does not clone demonstrations (ddpg.demo_bc_weight > 0 runs on the CPU)");
+}
+
 std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice device) {
   if (device == UpdateDevice::kCpu) {
     return std::make_unique<CpuUpdateBackend>(ddpg);

@@ -30,6 +30,10 @@ class UpdateBackend {
   // before the first has finished). Cost: CPU ~ the update itself; GPU ~ a 20 KB copy into a
   // pinned buffer and a graph launch, plus waiting for the previous update.
   virtual UpdateStats update(const BatchView& batch) = 0;
+  // One update that also clones `demos` (ddpg.demo_bc_weight > 0; Ddpg::update). The CPU backend
+  // has it; make_update_backend gives the CPU one whenever the config clones, so the others throw
+  // std::logic_error.
+  virtual UpdateStats update(const BatchView& batch, const BatchView& demos);
   // Waits for every queued update; returns the newest one's statistics.
   virtual UpdateStats finish() = 0;
 
@@ -65,8 +69,7 @@ class CpuUpdateBackend final : public UpdateBackend {
     last_ = ddpg_.update(batch);
     return last_;
   }
-  // With demonstrations to clone (Ddpg::update); only the CPU backend has it.
-  UpdateStats update(const BatchView& batch, const BatchView& demos) {
+  UpdateStats update(const BatchView& batch, const BatchView& demos) override {
     last_ = ddpg_.update(batch, &demos);
     return last_;
   }

@@ -33,7 +33,7 @@ constexpr int kDrainBudget = 64;
 // would otherwise be hard checks in ReplayBuffer and RateLimiter).
 void check_shard_config(const ShardConfig& c) {
   const RateLimiterConfig& l = c.limiter;
-  if (c.capacity < 1 || c.obs_dim < 1 || c.action_dim < 1 || c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 ||
+  if (c.capacity < 1 || c.demo_capacity < 0 || c.obs_dim < 1 || c.action_dim < 1 || c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 ||
       !(l.samples_per_insert > 0.0) || !std::isfinite(l.samples_per_insert) || l.min_size < 0 || l.slack < 0) {
     throw std::runtime_error(
         "the learner's config gives capacity " + std::to_string(c.capacity) + ", widths " + std::to_string(c.obs_dim) +
@@ -64,7 +64,44 @@ ReplayShard::ReplayShard(const ShardConfig& config, int max_sample_batch)
   if (max_sample_batch < 1) {
     throw std::invalid_argument("ReplayShard: max_sample_batch must be >= 1");
   }
+  if (config.demo_capacity > 0) {
+    demos_.emplace(config.demo_capacity, config.obs_dim, config.action_dim);
+    demo_reply_.emplace(config.obs_dim, config.action_dim, max_sample_batch);
+    demo_terminals_.resize(static_cast<size_t>(max_sample_batch));
+  }
 }
+
+namespace {
+void insert_rows(ReplayBuffer& buffer, const wire::TransitionRows& rows) {
+  const size_t obs = rows.obs_dim;
+  const size_t act = rows.action_dim;
+  for (size_t i = 0; i < rows.count; ++i) {
+    buffer.insert(TransitionView{{rows.states + i * obs, obs},
+                                 {rows.actions + i * act, act},
+                                 rows.rewards[i],
+                                 {rows.next_states + i * obs, obs},
+                                 rows.terminals[i] != 0,
+                                 rows.mc_returns[i]});
+  }
+}
+
+wire::TransitionRows sample_rows(ReplayBuffer& buffer, Rng& rng, int n, BatchBuffers& reply,
+                                 std::vector<uint8_t>& terminals) {
+  buffer.sample(rng, n, reply);
+  for (int j = 0; j < n; ++j) {
+    terminals[static_cast<size_t>(j)] = reply.terminal[static_cast<size_t>(j)] != 0.0F ? 1 : 0;
+  }
+  return {static_cast<uint32_t>(n),
+          static_cast<uint32_t>(reply.obs_dim),
+          static_cast<uint32_t>(reply.action_dim),
+          reply.states.data(),
+          reply.actions.data(),
+          reply.rewards.data(),
+          reply.next_states.data(),
+          terminals.data(),
+          reply.mc_returns.data()};
+}
+}  // namespace
 
 bool ReplayShard::can_sample(int64_t n) const {
   if (n < 1 || n > max_sample_batch_) {
@@ -80,41 +117,38 @@ void ReplayShard::insert(const wire::TransitionRows& rows) {
   if (rows.count < 1 || !limiter_.can_insert(rows.count)) {
     misuse("insert: empty rows, or the rate limiter does not admit inserts now");
   }
-  const size_t obs = rows.obs_dim;
-  const size_t act = rows.action_dim;
-  for (size_t i = 0; i < rows.count; ++i) {
-    buffer_.insert(TransitionView{{rows.states + i * obs, obs},
-                                  {rows.actions + i * act, act},
-                                  rows.rewards[i],
-                                  {rows.next_states + i * obs, obs},
-                                  rows.terminals[i] != 0,
-                                  rows.mc_returns[i]});
-  }
+  insert_rows(buffer_, rows);
   limiter_.on_insert(rows.count);
+}
+
+void ReplayShard::insert_demos(const wire::TransitionRows& rows) {
+  if (!demos_ || static_cast<int>(rows.obs_dim) != config_.obs_dim ||
+      static_cast<int>(rows.action_dim) != config_.action_dim || rows.count < 1) {
+    misuse("insert_demos: no demonstration table, or rows of other widths or none");
+  }
+  insert_rows(*demos_, rows);
+}
+
+wire::TransitionRows ReplayShard::sample_demos(int n) {
+  if (demo_size() == 0 || n < 1 || n > max_sample_batch_) {
+    misuse("sample_demos: the demonstration table is empty or absent, or n is outside [1, max_sample_batch]");
+  }
+  return sample_rows(*demos_, rng_, n, *demo_reply_, demo_terminals_);
 }
 
 wire::TransitionRows ReplayShard::sample(int n) {
   if (!can_sample(n)) {
     misuse("sample: the shard is empty or the rate limiter does not admit this sample now");
   }
-  buffer_.sample(rng_, n, reply_);
-  for (int j = 0; j < n; ++j) {
-    terminals_[static_cast<size_t>(j)] = reply_.terminal[static_cast<size_t>(j)] != 0.0F ? 1 : 0;
-  }
   limiter_.on_sample(n);
-  return {static_cast<uint32_t>(n),
-          static_cast<uint32_t>(config_.obs_dim),
-          static_cast<uint32_t>(config_.action_dim),
-          reply_.states.data(),
-          reply_.actions.data(),
-          reply_.rewards.data(),
-          reply_.next_states.data(),
-          terminals_.data(),
-          reply_.mc_returns.data()};
+  return sample_rows(buffer_, rng_, n, reply_, terminals_);
 }
 
 void ReplayShard::load_snapshot(const std::string& path) {
   load_replay_snapshot(path, buffer_);
+  if (demos_ && std::filesystem::exists(path + ".demos")) {
+    load_replay_snapshot(path + ".demos", *demos_);
+  }
   const int64_t inserts = buffer_.size();
   const double allowed = config_.limiter.samples_per_insert * static_cast<double>(inserts - config_.limiter.min_size);
   limiter_.set_counters(inserts, allowed > 0.0 ? static_cast<int64_t>(std::floor(allowed)) : 0);
@@ -122,6 +156,9 @@ void ReplayShard::load_snapshot(const std::string& path) {
 
 void ReplayShard::save_snapshot(const std::string& path) const {
   save_replay_snapshot(path, buffer_);
+  if (demos_) {
+    save_replay_snapshot(path + ".demos", *demos_);
+  }
 }
 
 void ReplayShard::set_limiter_config(const RateLimiterConfig& config) {
@@ -199,6 +236,7 @@ ShardCounters ShardServer::counters() const {
   constexpr auto r = std::memory_order_relaxed;
   ShardCounters c;
   c.inserted = inserted_.load(r);
+  c.demo_inserted = demo_inserted_.load(r);
   c.sampled = sampled_.load(r);
   c.malformed = malformed_.load(r);
   c.requests_waiting = waiting_now_.load(r);
@@ -429,6 +467,20 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
       malformed(log_insert_, "insert", "TransitionBatch with wrong widths, sizes, count or non-finite values", now);
       continue;
     }
+    if (batch->table() == wire::kDemoTable) {
+      if (!shard_->has_demo_table()) {
+        malformed(log_insert_, "insert",
+                  "TransitionBatch for the demonstration table, and this run keeps none (ddpg.demo_bc_weight = 0)", now);
+        continue;
+      }
+      shard_->insert_demos(wire::rows_of(batch));
+      demo_inserted_.fetch_add(batch->count(), std::memory_order_relaxed);
+      continue;
+    }
+    if (batch->table() != wire::kReplayTable) {
+      malformed(log_insert_, "insert", "TransitionBatch for a table that does not exist", now);
+      continue;
+    }
     shard_->insert(wire::rows_of(batch));
     inserted_.fetch_add(batch->count(), std::memory_order_relaxed);
     size_.store(shard_->buffer().size(), std::memory_order_relaxed);
@@ -448,7 +500,8 @@ void ShardServer::read_sample_socket(Clock::time_point now) {
       malformed(log_sample_, "sample", "not a SampleRequest", now);
       continue;
     }
-    if (request->batch_size() < 1 || request->batch_size() > options_.max_batch_transitions) {
+    if (request->batch_size() < 1 || request->batch_size() > options_.max_batch_transitions ||
+        request->demo_batch_size() > options_.max_batch_transitions) {
       malformed(log_sample_, "sample", "SampleRequest batch_size outside [1, max_batch_transitions]", now);
       continue;
     }
@@ -461,6 +514,7 @@ void ShardServer::read_sample_socket(Clock::time_point now) {
     slot.identity_size = static_cast<uint8_t>(identity_.size());
     slot.request_id = request->request_id();
     slot.batch_size = request->batch_size();
+    slot.demo_batch_size = request->demo_batch_size();
     ++waiting_count_;
     waiting_now_.store(waiting_count_, std::memory_order_relaxed);
     serve_waiting_requests(now);
@@ -474,7 +528,12 @@ void ShardServer::serve_waiting_requests(Clock::time_point now) {
       return;
     }
     const wire::TransitionRows rows = shard_->sample(static_cast<int>(head.batch_size));
-    wire::build_sample_reply(fbb_, head.request_id, rows);
+    if (head.demo_batch_size > 0 && shard_->demo_size() > 0) {
+      const wire::TransitionRows demos = shard_->sample_demos(static_cast<int>(head.demo_batch_size));
+      wire::build_sample_reply(fbb_, head.request_id, rows, &demos);
+    } else {
+      wire::build_sample_reply(fbb_, head.request_id, rows);
+    }
     // Counted before the send, so that whoever holds the reply sees the counters that include it
     // (the slot stays untouched until the next push).
     sampled_.fetch_add(head.batch_size, std::memory_order_relaxed);

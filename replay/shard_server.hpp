@@ -52,6 +52,9 @@ namespace pamdp {
 // Everything about a shard that the experiment (the learner's ClusterMap) decides.
 struct ShardConfig {
   int64_t capacity = 0;  // transitions (replay.capacity / replay.shards)
+  // The demonstration table (cloning, ddpg.demo_bc_weight > 0): transitions it holds, FIFO, not
+  // paced by the rate limiter; 0: no such table (a batch for it is refused as malformed).
+  int64_t demo_capacity = 0;
   int obs_dim = 0;
   int action_dim = 0;  // the full actor output vector
   RateLimiterConfig limiter;
@@ -77,8 +80,18 @@ class ReplayShard {
   // shard's reply scratch and stay valid until the next sample().
   wire::TransitionRows sample(int n);
 
+  // The demonstration table (config.demo_capacity > 0), outside the rate limiter.
+  [[nodiscard]] bool has_demo_table() const { return demos_.has_value(); }
+  [[nodiscard]] int64_t demo_size() const { return demos_ ? demos_->size() : 0; }
+  // Requires has_demo_table() and validated rows; misuse aborts.
+  void insert_demos(const wire::TransitionRows& rows);
+  // Requires demo_size() > 0 and n in [1, max_sample_batch]. The rows view a scratch of their own
+  // (valid with sample()'s at once) until the next sample_demos().
+  wire::TransitionRows sample_demos(int n);
+
   // Loads a snapshot written by save_snapshot (throws std::runtime_error naming the file and
-  // the problem: unreadable, corrupt, other capacity or widths). The limiter resumes balanced:
+  // the problem: unreadable, corrupt, other capacity or widths). The demonstration table, if any,
+  // is in PATH.demos beside it, loaded when that file exists. The limiter resumes balanced:
   // the stored transitions count as inserts (past the warm-up) and as many samples as the
   // ratio allows, so sampling continues at the ratio instead of replaying old data at will.
   void load_snapshot(const std::string& path);
@@ -99,6 +112,9 @@ class ReplayShard {
   Rng rng_;
   BatchBuffers reply_;              // column per sample = row-major rows on the wire
   std::vector<uint8_t> terminals_;  // the wire's 0/1 bytes
+  std::optional<ReplayBuffer> demos_;
+  std::optional<BatchBuffers> demo_reply_;
+  std::vector<uint8_t> demo_terminals_;
 };
 
 struct ShardServerOptions {
@@ -132,6 +148,7 @@ struct ShardServerOptions {
 // Counters, readable from any thread (each field is read atomically, not all together).
 struct ShardCounters {
   int64_t inserted = 0;             // transitions stored by this process
+  int64_t demo_inserted = 0;        // demonstrations stored (the demonstration table)
   int64_t sampled = 0;              // transitions drawn for replies
   int64_t malformed = 0;            // messages dropped as malformed, all sockets
   int64_t requests_waiting = 0;     // sample requests queued now
@@ -182,6 +199,7 @@ class ShardServer {
     uint8_t identity_size = 0;
     uint64_t request_id = 0;
     uint32_t batch_size = 0;
+    uint32_t demo_batch_size = 0;
   };
   // Once-per-second logging per kind of event, with the number of events in between.
   struct LogGate {
@@ -241,7 +259,7 @@ class ShardServer {
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
       size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0},
-      restored_{0};
+      restored_{0}, demo_inserted_{0};
 };
 
 }  // namespace pamdp

@@ -49,6 +49,7 @@ struct BatchCopy {
   uint32_t actor_id = 0;
   uint64_t sequence = 0;
   uint32_t count = 0;
+  uint8_t table = 0;  // wire::kReplayTable or wire::kDemoTable
   std::vector<float> states, actions, rewards, next_states, returns;
   std::vector<uint8_t> terminals;
 };
@@ -98,6 +99,7 @@ class FakeShard {
       BatchCopy c;
       c.actor_id = b->actor_id();
       c.sequence = b->sequence();
+      c.table = b->table();
       c.count = r.count;
       c.states.assign(r.states, r.states + r.count * kObs);
       c.next_states.assign(r.next_states, r.next_states + r.count * kObs);

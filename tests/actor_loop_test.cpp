@@ -212,6 +212,45 @@ TEST(ActorLoop, PlaysDemonstrationsAndReportsThemAsScripted) {
   EXPECT_GE(agent, 10);
 }
 
+// Cloning: the demonstrations go to the demonstration table too, and with demo_relabel the
+// agent's own steps go there with the teacher's action as their label, so every row of that table
+// is the teacher's and it gets about as many rows as the replay table.
+TEST(ActorLoop, FeedsTheDemonstrationTableWithDemonstrationsAndLabels) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorLoopConfig config = test_loop_config();
+  config.exploration.demo_fraction = 0.5;
+  config.exploration.demo_relabel = true;
+  config.demo_table = true;
+  config.make_teacher = [] { return std::make_unique<SlowMover>(); };
+  ActorRunner actor(ctx, learner.join_endpoint(), config, /*envs=*/2);
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 60; }));
+
+  size_t replay_rows = 0;
+  size_t demo_rows = 0;
+  size_t teacher_replay_rows = 0;
+  for (const BatchCopy& b : shard.batches) {
+    for (size_t t = 0; t < b.count; ++t) {
+      const bool teachers = b.actions[t * kWidth] == 1.0F && b.actions[t * kWidth + 1] == -1.0F &&
+                            b.actions[t * kWidth + 2] == 0.25F;
+      if (b.table == wire::kDemoTable) {
+        ++demo_rows;
+        EXPECT_TRUE(teachers) << "a row of the demonstration table that is not the teacher's";
+      } else {
+        ASSERT_EQ(b.table, wire::kReplayTable);
+        ++replay_rows;
+        teacher_replay_rows += teachers ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(teacher_replay_rows, 0U);
+  EXPECT_LT(teacher_replay_rows, replay_rows);
+  // Every step is labelled or demonstrated once: the tables differ by the rows still unsent.
+  EXPECT_NEAR(static_cast<double>(demo_rows), static_cast<double>(replay_rows), 3.0 * 64);
+}
+
 TEST(ActorLoop, AppliesPublishedWeightsAndActsWithThem) {
   net::Context ctx;
   FakeLearner learner(ctx);
@@ -438,6 +477,19 @@ TEST(ActorLoop, RejectsAnEmptyEnvListAndBadSettings) {
   std::vector<std::unique_ptr<Env>> one;
   one.push_back(std::make_unique<toy::ReachStopEnv>());
   EXPECT_THROW(make(bad, std::move(one)), std::invalid_argument);
+  // Demonstrations without a teacher, labels without the demonstration table.
+  ActorLoopConfig no_teacher = test_loop_config();
+  no_teacher.exploration.demo_fraction = 0.5;
+  std::vector<std::unique_ptr<Env>> two;
+  two.push_back(std::make_unique<toy::ReachStopEnv>());
+  EXPECT_THROW(make(no_teacher, std::move(two)), std::invalid_argument);
+  ActorLoopConfig no_table = test_loop_config();
+  no_table.exploration.demo_fraction = 0.5;
+  no_table.exploration.demo_relabel = true;
+  no_table.make_teacher = [] { return std::make_unique<SlowMover>(); };
+  std::vector<std::unique_ptr<Env>> three;
+  three.push_back(std::make_unique<toy::ReachStopEnv>());
+  EXPECT_THROW(make(no_table, std::move(three)), std::invalid_argument);
 }
 
 }  // namespace

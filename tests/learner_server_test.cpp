@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -43,19 +44,29 @@ LearnerServerConfig loopback_config() {
   return c;
 }
 
+DdpgConfig cloning() {
+  DdpgConfig c = small();
+  c.demo_bc_weight = 1.0;
+  c.demo_q_filter = false;
+  return c;
+}
+
 struct Running {
   net::Context ctx;
   toy::ReachStopEnv env;
-  Ddpg ddpg{kObs, env.action_space(), small(), 1};
+  Ddpg ddpg;
   CpuUpdateBackend backend{ddpg};
   std::unique_ptr<LearnerServer> server;
   std::thread thread;
   std::atomic<bool> done{false};
-  Running() {
+  explicit Running(bool clone_demos = false, std::function<void(const UpdateStats&)> on_update = {})
+      : ddpg(kObs, env.action_space(), clone_demos ? cloning() : small(), 1) {
     LearnerServerConfig c = loopback_config();
     c.publish_every_updates = 5;
     c.max_updates = 20;
+    c.clone_demos = clone_demos;
     server = std::make_unique<LearnerServer>(ctx, backend, c);
+    server->on_update = std::move(on_update);
     thread = std::thread([this] {
       server->run();  // returns by itself after max_updates
       done.store(true);
@@ -166,6 +177,66 @@ TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   EXPECT_GE(run.server->counters().weights_version, 2);
   // junk, wrong type, truncated, wrong-width reply.
   EXPECT_EQ(run.server->counters().malformed_messages, 4);
+}
+
+// Cloning on the cluster: every request asks for demonstrations too, and an update clones the
+// ones a reply carries (and runs plain without them).
+TEST(LearnerServer, ClonesTheDemonstrationsARepliesCarries) {
+  std::atomic<int> cloned{0};
+  Running run(/*clone_demos=*/true, [&](const UpdateStats& s) {
+    if (s.bc_accepted_fraction > 0.0F) {
+      cloned.fetch_add(1);
+    }
+  });
+  net::Context& ctx = run.ctx;
+  net::Socket sample(ctx, net::SocketType::kRouter);
+  const std::string sample_endpoint = sample.bind("tcp://127.0.0.1:*");
+  net::Socket join(ctx, net::SocketType::kDealer);
+  join.connect(run.server->join_endpoint());
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
+  ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
+
+  net::Message id;
+  net::Message req;
+  std::vector<float> states(kBatch * kObs, 0.1F);
+  std::vector<float> actions(kBatch * kAct, 0.2F);
+  std::vector<float> demo_actions(kBatch * kAct, -0.5F);
+  std::vector<float> rewards(kBatch, 1.0F);
+  std::vector<uint8_t> terminals(kBatch, 1);
+  std::vector<float> returns(kBatch, 1.0F);
+  int served = 0;
+  int with_demos = 0;
+  const auto until = Clock::now() + std::chrono::seconds(10);
+  while (!run.done.load() && Clock::now() < until) {
+    if (!sample.recv_from(id, req, 100)) {
+      continue;
+    }
+    const wire::Envelope* env = wire::open_envelope(req.bytes());
+    ASSERT_NE(env, nullptr);
+    const wire::SampleRequest* r = env->payload_as_SampleRequest();
+    ASSERT_NE(r, nullptr);
+    EXPECT_EQ(r->demo_batch_size(), static_cast<uint32_t>(kBatch));
+    const wire::TransitionRows rows{kBatch,         kObs,           kAct,          states.data(),
+                                    actions.data(), rewards.data(), states.data(), terminals.data(),
+                                    returns.data()};
+    wire::TransitionRows demos = rows;
+    demos.actions = demo_actions.data();
+    // Every other reply without demonstrations (a shard that holds none yet).
+    const bool give = served % 2 == 1;
+    wire::build_sample_reply(fbb, r->request_id(), rows, give ? &demos : nullptr);
+    ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
+    ++served;
+    with_demos += give ? 1 : 0;
+  }
+  ASSERT_TRUE(run.done.load()) << "the learner did not reach max_updates";  // run() has returned
+  const int64_t updates = run.server->counters().updates;
+  EXPECT_GE(updates, 20);
+  // Replies are served in order; the learner updates once per reply it reads.
+  EXPECT_EQ(run.server->counters().demo_samples_received, int64_t{kBatch} * cloned.load());
+  EXPECT_GE(cloned.load(), 9);
+  EXPECT_LE(cloned.load(), with_demos);
+  EXPECT_EQ(run.server->counters().malformed_messages, 0);
 }
 
 // Waits for an envelope of the given payload type on `s` (skipping others); nullptr on timeout.

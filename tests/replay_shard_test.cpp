@@ -252,6 +252,42 @@ TEST(ReplayShard, FifoDropsTheOldest) {
   EXPECT_EQ(seen.size(), 32U);
 }
 
+// The demonstration table: its own FIFO of its own capacity, sampled on its own, outside the
+// rate limiter; the replay table does not see it.
+TEST(ReplayShard, TheDemonstrationTableIsItsOwn) {
+  ShardConfig c = small_config(1.0, 1, 1000, 100);
+  c.demo_capacity = 3;
+  ReplayShard shard(c, 16);
+  ASSERT_TRUE(shard.has_demo_table());
+  shard.insert(make_rows(2, 0.0F).view());
+  shard.insert_demos(make_rows(5, 50.0F).view());  // 50 and 51 are overwritten
+  EXPECT_EQ(shard.buffer().size(), 2);
+  EXPECT_EQ(shard.demo_size(), 3);
+  EXPECT_EQ(shard.limiter().inserts(), 2);
+  const std::vector<float> demos = expect_known_rows(shard.sample_demos(16), 52.0F, 54.0F);
+  EXPECT_EQ(demos.size(), 16U);
+  EXPECT_EQ(shard.limiter().samples(), 0);
+  // Both views are valid at once: the reply carries both.
+  const wire::TransitionRows replay = shard.sample(8);
+  const wire::TransitionRows more = shard.sample_demos(8);
+  expect_known_rows(replay, 0.0F, 1.0F);
+  expect_known_rows(more, 52.0F, 54.0F);
+  EXPECT_FALSE(ReplayShard(small_config(), 16).has_demo_table());
+
+  // The snapshot keeps the demonstrations beside the replay (PATH.demos).
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("pamdp-demo-snapshot-" + std::to_string(getpid()))).string();
+  shard.save_snapshot(path);
+  ASSERT_TRUE(std::filesystem::exists(path + ".demos"));
+  ReplayShard restored(c, 16);
+  restored.load_snapshot(path);
+  EXPECT_EQ(restored.buffer().size(), 2);
+  EXPECT_EQ(restored.demo_size(), 3);
+  expect_known_rows(restored.sample_demos(8), 52.0F, 54.0F);
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".demos");
+}
+
 TEST(ReplayShardDeathTest, MisuseStops) {
   ReplayShard shard(small_config(1.0, 10, 0), 8);
   EXPECT_DEATH(shard.insert(make_rows(1, 0.0F, kObs + 1).view()), "widths");
@@ -440,8 +476,8 @@ class FakeActor {
   FakeActor(net::Context& ctx, const std::string& insert_endpoint) : dealer_(ctx, net::SocketType::kDealer) {
     dealer_.connect(insert_endpoint);
   }
-  void insert(const Rows& rows, uint64_t sequence = 0) {
-    wire::build_transition_batch(fbb_, 7, sequence, rows.view());
+  void insert(const Rows& rows, uint64_t sequence = 0, uint8_t table = wire::kReplayTable) {
+    wire::build_transition_batch(fbb_, 7, sequence, rows.view(), table);
     ASSERT_TRUE(dealer_.send(wire::bytes_of(fbb_), 1000));
   }
   void send_raw(std::span<const uint8_t> bytes) { ASSERT_TRUE(dealer_.send(bytes, 1000)); }
@@ -458,8 +494,8 @@ class FakeSampler {
   FakeSampler(net::Context& ctx, const std::string& sample_endpoint) : dealer_(ctx, net::SocketType::kDealer) {
     dealer_.connect(sample_endpoint);
   }
-  void request(uint64_t id, uint32_t batch) {
-    wire::build_sample_request(fbb_, id, batch);
+  void request(uint64_t id, uint32_t batch, uint32_t demo_batch = 0) {
+    wire::build_sample_request(fbb_, id, batch, demo_batch);
     ASSERT_TRUE(dealer_.send(wire::bytes_of(fbb_), 1000));
   }
   // The next reply's batch (verified), or nullptr on timeout. Valid until the next call.
@@ -519,6 +555,60 @@ TEST(ShardServer, InsertedTransitionsComeBackExactly) {
   EXPECT_EQ(c.map_version, 1);
   EXPECT_LT(shard.stop().count(), 500);
   EXPECT_EQ(shard.error(), "");
+}
+
+// Cloning on the cluster: demonstrations go to their own table, and a request that asks for them
+// gets them beside the batch once there are any; a shard without the table refuses them.
+TEST(ShardServer, DemonstrationsComeBackBesideTheBatch) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  ShardConfig c = small_config();
+  c.demo_capacity = 100;
+  RunningShard shard(ctx, test_options(learner), fixed_config(c));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  actor.insert(make_rows(5, 10.0F));
+  ASSERT_TRUE(eventually([&] { return shard.server().counters().inserted == 5; }));
+
+  FakeSampler sampler(ctx, shard.server().sample_endpoint());
+  sampler.request(1, 32, 16);  // no demonstrations yet: the batch alone
+  const wire::SampleReply* r = sampler.reply();
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->demos(), nullptr);
+
+  actor.insert(make_rows(3, 70.0F), 1, wire::kDemoTable);
+  ASSERT_TRUE(eventually([&] { return shard.server().counters().demo_inserted == 3; }));
+  sampler.request(2, 32, 16);
+  r = sampler.reply();
+  ASSERT_NE(r, nullptr);
+  expect_known_rows(wire::rows_of(r->batch()), 10.0F, 14.0F);
+  ASSERT_NE(r->demos(), nullptr);
+  ASSERT_TRUE(wire::valid_batch(r->demos(), kObs, kAct, 16));
+  EXPECT_EQ(r->demos()->count(), 16U);
+  expect_known_rows(wire::rows_of(r->demos()), 70.0F, 72.0F);
+  sampler.request(3, 32);  // not asked for: none
+  r = sampler.reply();
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->demos(), nullptr);
+  const ShardCounters k = shard.server().counters();
+  EXPECT_EQ(k.inserted, 5);
+  EXPECT_EQ(k.sampled, 96);
+  EXPECT_EQ(k.malformed, 0);
+  EXPECT_EQ(shard.error(), "");
+}
+
+TEST(ShardServer, DemonstrationsWithoutATableAreMalformed) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config()));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  actor.insert(make_rows(3, 70.0F), 0, wire::kDemoTable);
+  actor.insert(make_rows(3, 70.0F), 1, 7);  // no such table
+  actor.insert(make_rows(2, 10.0F), 2);
+  ASSERT_TRUE(eventually([&] { return shard.server().counters().inserted == 2; }));
+  EXPECT_TRUE(eventually([&] { return shard.server().counters().malformed == 2; }));
+  EXPECT_EQ(shard.server().counters().demo_inserted, 0);
 }
 
 // With CURVE, the shard's insert and sample sockets take nothing from a client whose key the

@@ -119,6 +119,7 @@ class CudaUpdateBackend final : public UpdateBackend {
 
   [[nodiscard]] const char* name() const override { return "cuda"; }
 
+  using UpdateBackend::update;  // cloning: the base's refusal (make_update_backend picks the CPU)
   UpdateStats update(const BatchView& batch) override {
     const int B = ddpg_.config().batch_size;
     if (batch.states.cols() != B || batch.states.rows() != ddpg_.obs_dim() ||
