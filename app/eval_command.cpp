@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "learner/greedy_policy.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
@@ -25,6 +24,7 @@
 #include "envs/registry.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/evaluation.hpp"
+#include "learner/greedy_policy.hpp"
 
 namespace pamdp::app {
 namespace {

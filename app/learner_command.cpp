@@ -15,21 +15,17 @@
 #include <string>
 #include <vector>
 
-#include "learner/greedy_policy.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "app/network_security.hpp"
 #include "app/role_metrics.hpp"
-#include "learner/run_logs.hpp"
 #include "app/run_options.hpp"
 #include "app/run_support.hpp"
-#include "core/files.hpp"
 #include "core/log.hpp"
 #include "core/transport.hpp"
-#include "learner/checkpoint.hpp"
-#include "learner/evaluation.hpp"
 #include "learner/learner_server.hpp"
+#include "learner/training_run.hpp"
 #include "learner/update_backend.hpp"
 
 namespace pamdp::app {
@@ -98,8 +94,8 @@ void run_learner(const LearnerCliOptions& o) {
   spec.seed = c.seed;
   spec.loop = c.train;
   spec.exploration = exploration;
-  spec.extra_metric_columns = {"samples_per_s",     "shards",           "actors_joined", "weights_version",
-                               "malformed_messages", "waiting_for_data_ms"};
+  spec.extra_metric_columns = {"samples_per_s",      "shards", "actors_joined", "weights_version", "malformed_messages",
+                               "waiting_for_data_ms"};
   // With cloning, metrics.csv also says how much of it the Q-filter lets through (as train's).
   const bool clones = c.ddpg.demo_bc_weight > 0.0;
   if (clones) {

@@ -13,17 +13,15 @@
 #include <vector>
 
 #include "actor/exploration.hpp"
-#include "learner/greedy_policy.hpp"
 #include "app/env_factory.hpp"
 #include "app/progress.hpp"
 #include "app/role_metrics.hpp"
-#include "learner/run_logs.hpp"
 #include "app/run_support.hpp"
-#include "core/files.hpp"
 #include "core/log.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/training_run.hpp"
 #include "learner/update_backend.hpp"
 #include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"

@@ -277,7 +277,8 @@ void LearnerServer::handle_shard(Shard& shard) {
       return;
     }
     const wire::TransitionBatch* d = config_.clone_demos ? env->payload_as_SampleReply()->demos() : nullptr;
-    if (d != nullptr && (!wire::valid_batch(d, obs, act, static_cast<uint32_t>(B)) || d->count() != static_cast<uint32_t>(B))) {
+    if (d != nullptr &&
+        (!wire::valid_batch(d, obs, act, static_cast<uint32_t>(B)) || d->count() != static_cast<uint32_t>(B))) {
       note_malformed("SampleReply with demonstrations of wrong sizes");
       return;
     }

@@ -66,9 +66,8 @@ CheckpointMeta TrainingRun::start(bool resume) {
   }
   std::optional<ResumePoint> resume_at;
   if (resume) {
-    resume_at = ResumePoint{ddpg_.updates(), spec_.keeps_episodes_after_checkpoint
-                                                 ? std::nullopt
-                                                 : std::optional<int64_t>(meta.episodes)};
+    resume_at = ResumePoint{
+        ddpg_.updates(), spec_.keeps_episodes_after_checkpoint ? std::nullopt : std::optional<int64_t>(meta.episodes)};
   }
   logs_.emplace(spec_.dir, spec_.extra_metric_columns, resume_at);
   if (resume) {
@@ -130,7 +129,9 @@ void TrainingRun::record_episode(const FinishedEpisode& e) {
   logs_->episode(row);
 }
 
-bool TrainingRun::evaluation_due() const { return ddpg_.updates() >= next_eval_; }
+bool TrainingRun::evaluation_due() const {
+  return ddpg_.updates() >= next_eval_;
+}
 
 bool TrainingRun::evaluate_if_due() {
   if (!evaluation_due()) {
@@ -155,7 +156,9 @@ void TrainingRun::evaluate() {
   }
   std::function<EvalResult()> confirm;
   if (loop.confirm_episodes > 0) {
-    confirm = [&] { return pamdp::evaluate(eval_env_, policy, loop.confirm_episodes, confirmation_seed(spec_.seed, at)); };
+    confirm = [&] {
+      return pamdp::evaluate(eval_env_, policy, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
+    };
   }
   // The actor (with everything else) of the best greedy evaluation so far: what `pamdp eval
   // --checkpoint RUN/best.ckpt` should be given when the final policy is worse than an earlier one.

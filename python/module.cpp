@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "actor/exploration.hpp"
-#include "learner/greedy_policy.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/greedy_policy.hpp"
 #include "python/env_registry.hpp"
 #include "python/vector_env.hpp"
 

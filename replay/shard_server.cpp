@@ -33,8 +33,9 @@ constexpr int kDrainBudget = 64;
 // would otherwise be hard checks in ReplayBuffer and RateLimiter).
 void check_shard_config(const ShardConfig& c) {
   const RateLimiterConfig& l = c.limiter;
-  if (c.capacity < 1 || c.demo_capacity < 0 || c.obs_dim < 1 || c.action_dim < 1 || c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 ||
-      !(l.samples_per_insert > 0.0) || !std::isfinite(l.samples_per_insert) || l.min_size < 0 || l.slack < 0) {
+  if (c.capacity < 1 || c.demo_capacity < 0 || c.obs_dim < 1 || c.action_dim < 1 || c.heartbeat_ms < 1 ||
+      c.peer_timeout_ms < 1 || !(l.samples_per_insert > 0.0) || !std::isfinite(l.samples_per_insert) ||
+      l.min_size < 0 || l.slack < 0) {
     throw std::runtime_error(
         "the learner's config gives capacity " + std::to_string(c.capacity) + ", widths " + std::to_string(c.obs_dim) +
         "/" + std::to_string(c.action_dim) + ", heartbeat " + std::to_string(c.heartbeat_ms) + " ms, timeout " +
@@ -470,7 +471,8 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
     if (batch->table() == wire::kDemoTable) {
       if (!shard_->has_demo_table()) {
         malformed(log_insert_, "insert",
-                  "TransitionBatch for the demonstration table, and this run keeps none (ddpg.demo_bc_weight = 0)", now);
+                  "TransitionBatch for the demonstration table, and this run keeps none (ddpg.demo_bc_weight = 0)",
+                  now);
         continue;
       }
       shard_->insert_demos(wire::rows_of(batch));

@@ -167,7 +167,8 @@ class FakeLearner {
         }
         case wire::Payload::EpisodeReport: {
           const auto* r = env->payload_as_EpisodeReport();
-          reports.push_back({r->actor_id(), r->episode(), r->return_(), r->steps(), r->status(), r->policy_version(), r->scripted()});
+          reports.push_back(
+              {r->actor_id(), r->episode(), r->return_(), r->steps(), r->status(), r->policy_version(), r->scripted()});
           break;
         }
         default: ADD_FAILURE() << "unexpected message type from the actor";

@@ -233,8 +233,8 @@ TEST(ActorLoop, FeedsTheDemonstrationTableWithDemonstrationsAndLabels) {
   size_t teacher_replay_rows = 0;
   for (const BatchCopy& b : shard.batches) {
     for (size_t t = 0; t < b.count; ++t) {
-      const bool teachers = b.actions[t * kWidth] == 1.0F && b.actions[t * kWidth + 1] == -1.0F &&
-                            b.actions[t * kWidth + 2] == 0.25F;
+      const bool teachers =
+          b.actions[t * kWidth] == 1.0F && b.actions[t * kWidth + 1] == -1.0F && b.actions[t * kWidth + 2] == 0.25F;
       if (b.table == wire::kDemoTable) {
         ++demo_rows;
         EXPECT_TRUE(teachers) << "a row of the demonstration table that is not the teacher's";
