@@ -29,6 +29,19 @@ BatchCopy concat(const std::vector<BatchCopy>& batches) {
   return all;
 }
 
+// The episodes in shipped rows, as [begin, end): contiguous runs ending in a terminal row.
+std::vector<std::pair<size_t, size_t>> episodes_in(const BatchCopy& rows) {
+  std::vector<std::pair<size_t, size_t>> episodes;
+  size_t begin = 0;
+  for (size_t t = 0; t < rows.count; ++t) {
+    if (rows.terminals[t] != 0) {
+      episodes.emplace_back(begin, t + 1);
+      begin = t + 1;
+    }
+  }
+  return episodes;
+}
+
 Bytes weights_message(uint64_t version, int64_t updates, uint8_t bound, const std::vector<float>& params,
                       std::span<const int> widths = kTestWidths) {
   flatbuffers::FlatBufferBuilder fbb;
@@ -77,14 +90,7 @@ TEST(ActorLoop, JoinsAndShipsTransitionsWithMonteCarloReturnsAndEpisodeReports) 
   // Episodes are contiguous runs of rows ending in a terminal row.
   const BatchCopy rows = concat(shard.batches);
   const auto gamma = static_cast<float>(config.gamma);
-  std::vector<std::pair<size_t, size_t>> episodes;  // [begin, end)
-  size_t begin = 0;
-  for (size_t t = 0; t < rows.count; ++t) {
-    if (rows.terminals[t] != 0) {
-      episodes.emplace_back(begin, t + 1);
-      begin = t + 1;
-    }
-  }
+  const std::vector<std::pair<size_t, size_t>> episodes = episodes_in(rows);
   ASSERT_GE(episodes.size(), 30U);
   for (const auto& [b, e] : episodes) {
     ASSERT_LE(e - b, 20U) << "ReachStop ends every episode within max_steps = 20";
@@ -172,14 +178,7 @@ TEST(ActorLoop, PlaysDemonstrationsAndReportsThemAsScripted) {
       serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 40 && learner.reports.size() >= 60; }));
 
   const BatchCopy rows = concat(shard.batches);
-  std::vector<std::pair<size_t, size_t>> episodes;
-  size_t begin = 0;
-  for (size_t t = 0; t < rows.count; ++t) {
-    if (rows.terminals[t] != 0) {
-      episodes.emplace_back(begin, t + 1);
-      begin = t + 1;
-    }
-  }
+  const std::vector<std::pair<size_t, size_t>> episodes = episodes_in(rows);
   // The teacher's rows: MOVE scored 1, STOP -1, its velocity.
   auto teachers_row = [&](size_t t) {
     return rows.actions[t * kWidth] == 1.0F && rows.actions[t * kWidth + 1] == -1.0F &&

@@ -83,6 +83,38 @@ bool receive(net::Socket& s, net::Message& m, int timeout_ms) {
   return s.recv(m, timeout_ms);
 }
 
+// A batch of constant rows for the toy task's widths.
+struct ConstantRows {
+  std::vector<float> states = std::vector<float>(kBatch * kObs, 0.1F);
+  std::vector<float> actions = std::vector<float>(kBatch * kAct, 0.2F);
+  std::vector<float> rewards = std::vector<float>(kBatch, 1.0F);
+  std::vector<uint8_t> terminals = std::vector<uint8_t>(kBatch, 1);
+  std::vector<float> returns = std::vector<float>(kBatch, 1.0F);
+  [[nodiscard]] wire::TransitionRows rows() const {
+    return {kBatch,           kObs,          kAct, states.data(), actions.data(), rewards.data(), states.data(),
+            terminals.data(), returns.data()};
+  }
+};
+
+// Plays a shard's sample socket until the learner has returned from run() (or 10 s pass):
+// `answer` gets every SampleRequest and the routing id to reply to.
+void serve_samples(Running& run, net::Socket& sample,
+                   const std::function<void(const wire::SampleRequest&, const net::Message&)>& answer) {
+  net::Message id;
+  net::Message req;
+  const auto until = Clock::now() + std::chrono::seconds(10);
+  while (!run.done.load() && Clock::now() < until) {
+    if (!sample.recv_from(id, req, 100)) {
+      continue;
+    }
+    const wire::Envelope* env = wire::open_envelope(req.bytes());
+    ASSERT_NE(env, nullptr);
+    const wire::SampleRequest* r = env->payload_as_SampleRequest();
+    ASSERT_NE(r, nullptr);
+    answer(*r, id);
+  }
+}
+
 TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   Running run;
   net::Context& ctx = run.ctx;
@@ -128,41 +160,22 @@ TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
 
   // Serve sample requests: first one malformed reply (wrong widths), then good ones.
-  net::Message id;
-  net::Message req;
-  std::vector<float> states(kBatch * kObs, 0.1F);
-  std::vector<float> actions(kBatch * kAct, 0.2F);
-  std::vector<float> rewards(kBatch, 1.0F);
-  std::vector<uint8_t> terminals(kBatch, 1);
-  std::vector<float> returns(kBatch, 1.0F);
+  const ConstantRows constant;
   bool sent_bad = false;
   int served = 0;
-  const auto until = Clock::now() + std::chrono::seconds(10);
-  while (!run.done.load() && Clock::now() < until) {
-    if (!sample.recv_from(id, req, 100)) {
-      continue;
-    }
-    const wire::Envelope* env = wire::open_envelope(req.bytes());
-    ASSERT_NE(env, nullptr);
-    const wire::SampleRequest* r = env->payload_as_SampleRequest();
-    ASSERT_NE(r, nullptr);
-    EXPECT_EQ(r->batch_size(), static_cast<uint32_t>(kBatch));
-    wire::TransitionRows rows{kBatch,         kObs,           kAct,          states.data(),
-                              actions.data(), rewards.data(), states.data(), terminals.data(),
-                              returns.data()};
+  serve_samples(run, sample, [&](const wire::SampleRequest& r, const net::Message& id) {
+    EXPECT_EQ(r.batch_size(), static_cast<uint32_t>(kBatch));
+    wire::TransitionRows rows = constant.rows();
+    std::vector<float> wide(kBatch * (kObs + 1), 0.0F);
     if (!sent_bad) {
       rows.obs_dim = kObs + 1;  // sizes that do not match the experiment
-      std::vector<float> wide(kBatch * (kObs + 1), 0.0F);
       rows.states = rows.next_states = wide.data();
-      wire::build_sample_reply(fbb, r->request_id(), rows);
-      ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
-      sent_bad = true;
-      continue;
     }
-    wire::build_sample_reply(fbb, r->request_id(), rows);
+    wire::build_sample_reply(fbb, r.request_id(), rows);
     ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
-    ++served;
-  }
+    served += sent_bad ? 1 : 0;
+    sent_bad = true;
+  });
   ASSERT_TRUE(run.done.load()) << "the learner did not reach max_updates";
   EXPECT_GE(run.ddpg.updates(), 20);
   EXPECT_GE(served, 20);
@@ -197,38 +210,22 @@ TEST(LearnerServer, ClonesTheDemonstrationsARepliesCarries) {
   wire::build_join_request(fbb, wire::Role::Shard, "shard", "tcp://127.0.0.1:1", sample_endpoint, 0);
   ASSERT_TRUE(join.send(wire::bytes_of(fbb), 1000));
 
-  net::Message id;
-  net::Message req;
-  std::vector<float> states(kBatch * kObs, 0.1F);
-  std::vector<float> actions(kBatch * kAct, 0.2F);
+  const ConstantRows constant;
   std::vector<float> demo_actions(kBatch * kAct, -0.5F);
-  std::vector<float> rewards(kBatch, 1.0F);
-  std::vector<uint8_t> terminals(kBatch, 1);
-  std::vector<float> returns(kBatch, 1.0F);
   int served = 0;
   int with_demos = 0;
-  const auto until = Clock::now() + std::chrono::seconds(10);
-  while (!run.done.load() && Clock::now() < until) {
-    if (!sample.recv_from(id, req, 100)) {
-      continue;
-    }
-    const wire::Envelope* env = wire::open_envelope(req.bytes());
-    ASSERT_NE(env, nullptr);
-    const wire::SampleRequest* r = env->payload_as_SampleRequest();
-    ASSERT_NE(r, nullptr);
-    EXPECT_EQ(r->demo_batch_size(), static_cast<uint32_t>(kBatch));
-    const wire::TransitionRows rows{kBatch,         kObs,           kAct,          states.data(),
-                                    actions.data(), rewards.data(), states.data(), terminals.data(),
-                                    returns.data()};
+  serve_samples(run, sample, [&](const wire::SampleRequest& r, const net::Message& id) {
+    EXPECT_EQ(r.demo_batch_size(), static_cast<uint32_t>(kBatch));
+    const wire::TransitionRows rows = constant.rows();
     wire::TransitionRows demos = rows;
     demos.actions = demo_actions.data();
     // Every other reply without demonstrations (a shard that holds none yet).
     const bool give = served % 2 == 1;
-    wire::build_sample_reply(fbb, r->request_id(), rows, give ? &demos : nullptr);
+    wire::build_sample_reply(fbb, r.request_id(), rows, give ? &demos : nullptr);
     ASSERT_TRUE(sample.send_to(id.bytes(), wire::bytes_of(fbb), 1000));
     ++served;
     with_demos += give ? 1 : 0;
-  }
+  });
   ASSERT_TRUE(run.done.load()) << "the learner did not reach max_updates";  // run() has returned
   const int64_t updates = run.server->counters().updates;
   EXPECT_GE(updates, 20);
