@@ -388,7 +388,7 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
                                 slot.demo)) {
     counters.reports_dropped.fetch_add(1, std::memory_order_relaxed);
   }
-  if (on_episode != nullptr && *on_episode) {
+  if (on_episode != nullptr && *on_episode && !slot.demo) {
     (*on_episode)(status, slot.ret, slot.steps);
   }
   reset(slot);

@@ -105,7 +105,8 @@ class ActorLoop {
 
   // Called on the run() thread about every tick_ms (progress lines); may be empty.
   std::function<void(const ActorCounters&, double epsilon)> on_tick;
-  // Called on the run() thread at the end of every episode (metrics) with the env's terminal
+  // Called on the run() thread at the end of every episode the agent played (metrics; not for
+  // demonstrations, which the learner also leaves out of its rates) with the env's terminal
   // status, the undiscounted return and the steps; may be empty; must not allocate.
   std::function<void(int status, double ret, int steps)> on_episode;
 

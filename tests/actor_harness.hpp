@@ -235,6 +235,7 @@ class ActorRunner {
       }
       ActorLoop loop(ctx, std::move(link), *map, std::move(list), config, counters);
       loop.on_tick = on_tick;
+      loop.on_episode = [this](int /*status*/, double /*ret*/, int /*steps*/) { agent_episodes.fetch_add(1); };
       running = true;
       loop.run(stop);
     });
@@ -249,6 +250,7 @@ class ActorRunner {
   ActorCounters counters;
   std::atomic<bool> stop{false};
   std::atomic<bool> running{false};
+  std::atomic<int64_t> agent_episodes{0};  // on_episode calls: the episodes the agent played
   std::string config_toml;  // written by the actor thread before `running`
 
  private:

@@ -209,6 +209,11 @@ TEST(ActorLoop, PlaysDemonstrationsAndReportsThemAsScripted) {
   // Half the episodes, drawn: both kinds, in about equal numbers.
   EXPECT_GE(scripted, 10);
   EXPECT_GE(agent, 10);
+  // The actor's own episode metrics (on_episode) leave the demonstrations out.
+  const int64_t agents = actor.agent_episodes.load();
+  const int64_t all = actor.counters.episodes.load();
+  EXPECT_GT(agents, all / 4);
+  EXPECT_LT(agents, all * 3 / 4);
 }
 
 // Cloning: the demonstrations go to the demonstration table too, and with demo_relabel the
