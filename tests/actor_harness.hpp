@@ -251,7 +251,7 @@ class ActorRunner {
   std::atomic<bool> stop{false};
   std::atomic<bool> running{false};
   std::atomic<int64_t> agent_episodes{0};  // on_episode calls: the episodes the agent played
-  std::string config_toml;  // written by the actor thread before `running`
+  std::string config_toml;                 // written by the actor thread before `running`
 
  private:
   std::thread thread_;
