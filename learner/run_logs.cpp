@@ -4,7 +4,6 @@
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
-#include <deque>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -267,20 +266,6 @@ void for_each_logged_episode(const fs::path& dir, const std::function<void(const
     e.outcome = std::move(f[6]);
     visit(e);
   }
-}
-
-std::vector<LoggedEpisode> last_logged_episodes(const fs::path& dir, size_t n) {
-  if (n == 0) {
-    return {};
-  }
-  std::deque<LoggedEpisode> last;
-  for_each_logged_episode(dir, [&](const LoggedEpisode& e) {
-    last.push_back(e);
-    if (last.size() > n) {
-      last.pop_front();
-    }
-  });
-  return {std::make_move_iterator(last.begin()), std::make_move_iterator(last.end())};
 }
 
 BestEval::BestEval(fs::path file, std::string role) : file_(std::move(file)), role_(std::move(role)) {

@@ -115,12 +115,9 @@ struct LoggedEpisode {
   bool scripted = false;
 };
 
-// The last `n` rows of dir/episodes.csv, oldest first (none when there is no file). A resumed
-// run reads them to refill its last-100 training rates, which would otherwise start empty.
-// Rows that do not parse (one cut off by a kill) are skipped.
-std::vector<LoggedEpisode> last_logged_episodes(const std::filesystem::path& dir, size_t n);
 // Calls `visit` with every row of dir/episodes.csv that parses, in file order, holding one row at
-// a time (a long run's file has millions).
+// a time (a long run's file has millions); none when there is no file. A resumed run reads its
+// rows back with it (TrainingRun::start): rows cut off by a kill are skipped.
 void for_each_logged_episode(const std::filesystem::path& dir, const std::function<void(const LoggedEpisode&)>& visit);
 
 // Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
