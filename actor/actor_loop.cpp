@@ -174,7 +174,8 @@ struct ActorLoop::Impl {
   void reset(EnvSlot& slot);
 
   void send_batch(OutgoingBatch& b, uint8_t table);
-  void add_rows(EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table);
+  // Appends an episode whose returns are computed, sending every batch it fills.
+  void add_rows(const EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table);
   bool try_send(size_t index, std::span<const uint8_t> bytes, int timeout_ms, OutgoingBatch& b);
   Shard* pick_shard(Clock::time_point now);
   [[nodiscard]] bool another_available(size_t index, Clock::time_point now) const;
@@ -374,11 +375,14 @@ void ActorLoop::Impl::step(EnvSlot& slot) {
 
 void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   // The last step is terminal, time-outs included, as in the paper's code and `pamdp train`.
+  // Returns are computed once per buffer; a demonstration's rows go to both tables.
+  slot.episode.compute_returns(config.gamma);
   add_rows(slot.episode, batch, wire::kReplayTable);
   if (slot.demo && demo_batch) {
     add_rows(slot.episode, *demo_batch, wire::kDemoTable);
   }
   if (slot.label) {
+    slot.labelled->compute_returns(config.gamma);
     add_rows(*slot.labelled, *demo_batch, wire::kDemoTable);
   }
   ++slot.episodes;
@@ -438,8 +442,7 @@ bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int
 
 // Blocks (serving the control sockets) until a shard takes the batch or stop is set, in which
 // case the batch is dropped.
-void ActorLoop::Impl::add_rows(EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table) {
-  ep.compute_returns(config.gamma);
+void ActorLoop::Impl::add_rows(const EpisodeBuffer& ep, OutgoingBatch& b, uint8_t table) {
   for (size_t i = 0; i < ep.size(); ++i) {
     b.append(ep.transition(i));
     if (b.full()) {
