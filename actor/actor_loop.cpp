@@ -1,6 +1,5 @@
 #include "actor/actor_loop.hpp"
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -9,10 +8,8 @@
 #include <string>
 #include <utility>
 
-#include "core/actor_output.hpp"
-#include "core/bounds.hpp"
+#include "actor/acting_policy.hpp"
 #include "core/log.hpp"
-#include "core/mlp.hpp"
 #include "core/rng.hpp"
 #include "core/wire.hpp"
 #include "replay/episode_buffer.hpp"
@@ -22,8 +19,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr uint8_t kBoundSquashing = 2;  // PolicyWeights.bound: the learner squashes, so must we
-constexpr uint8_t kMaxBound = 2;
 constexpr int64_t kMaxWeightsBytes = int64_t{64} << 20;  // 16M parameters
 constexpr int64_t kMaxShardMessageBytes = 64 << 10;      // shards send actors nothing
 constexpr int kMaxLayerWidth = 1 << 16;
@@ -203,7 +198,6 @@ struct ActorLoop::Impl {
   int width;
   int num_actions;
   const ActionSpace& space;
-  OutputBounds bounds;
   uint32_t actor_index;
 
   // The cluster as the newest map describes it.
@@ -220,10 +214,14 @@ struct ActorLoop::Impl {
   // Acting.
   std::vector<EnvSlot> envs;
   EpsilonGreedy explore;
-  std::unique_ptr<Mlp<float>> policy;  // null until the first PolicyWeights
-  Eigen::MatrixXf input;
+  std::unique_ptr<ActingPolicy> policy;  // null until the first PolicyWeights
+  std::string policy_algorithm;          // the algorithm `policy` plays
+  // Built by check_weights for a message naming another algorithm than `policy`'s, taken by
+  // apply_weights; and the networks of the message being checked or applied.
+  std::unique_ptr<ActingPolicy> pending_policy;
+  std::string pending_algorithm;
+  std::vector<NetworkView> weights_networks;
   std::vector<float> net_out;
-  bool squash_output = false;
   uint64_t weights_version = 0;
   int64_t updates = 0;
   double eps = 1.0;
@@ -254,12 +252,10 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
       width(env_list.front()->action_space().output_width()),
       num_actions(env_list.front()->action_space().num_actions()),
       space(env_list.front()->action_space()),
-      bounds(OutputBounds::for_actor(env_list.front()->action_space())),
       actor_index(map.actor_index),
       sub(ctx, net::SocketType::kSub),
       explore(env_list.front()->action_space(), config.exploration,
               mix_seeds(config.seed, 1000 + uint64_t{map.actor_index})),
-      input(obs_dim, 1),
       net_out(static_cast<size_t>(width)),
       batch(config.batch_transitions, obs_dim, width),
       batch_fbb(static_cast<size_t>(config.batch_transitions) * (2 * area(1, obs_dim) + area(1, width) + 3) * 4 +
@@ -344,7 +340,7 @@ void ActorLoop::Impl::reset(EnvSlot& slot) {
 }
 
 void ActorLoop::Impl::forward(std::span<const float> obs) {
-  actor_output(*policy, input, obs, squash_output ? &bounds : nullptr, net_out);
+  policy->act(obs, net_out);
 }
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
@@ -559,30 +555,51 @@ const wire::PolicyWeights* ActorLoop::Impl::check_weights(std::span<const uint8_
     return nullptr;
   }
   const wire::PolicyWeights* w = env->payload_as_PolicyWeights();
-  const auto* widths = w->widths();
-  if (widths == nullptr || widths->size() < 2 || widths->Get(0) != obs_dim ||
-      widths->Get(widths->size() - 1) != width) {
-    note_malformed("PolicyWeights: widths do not fit this env's observation and action widths");
+  std::string_view algorithm;
+  weights_networks = wire::policy_networks(*w, algorithm);
+  if (weights_networks.empty()) {
+    note_malformed("PolicyWeights: no networks");
     return nullptr;
   }
-  int64_t expected = 0;
-  for (flatbuffers::uoffset_t l = 0; l < widths->size(); ++l) {
-    const int wl = widths->Get(l);
-    if (wl < 1 || wl > kMaxLayerWidth) {
-      note_malformed("PolicyWeights: a layer width out of range");
+  for (const NetworkView& n : weights_networks) {
+    if (n.widths.size() < 2) {
+      note_malformed("PolicyWeights: a network with fewer than two layer widths");
       return nullptr;
     }
-    if (l > 0) {
-      expected += int64_t{widths->Get(l - 1)} * wl + wl;
+    int64_t expected = 0;
+    for (size_t l = 0; l < n.widths.size(); ++l) {
+      if (n.widths[l] < 1 || n.widths[l] > kMaxLayerWidth) {
+        note_malformed("PolicyWeights: a layer width out of range");
+        return nullptr;
+      }
+      if (l > 0) {
+        expected += int64_t{n.widths[l - 1]} * n.widths[l] + n.widths[l];
+      }
+    }
+    if (static_cast<int64_t>(n.params.size()) != expected) {
+      note_malformed("PolicyWeights: parameter count does not match the widths");
+      return nullptr;
+    }
+    if (!std::all_of(n.params.begin(), n.params.end(), [](float v) { return std::isfinite(v); })) {
+      note_malformed("PolicyWeights: a parameter is not finite");
+      return nullptr;
     }
   }
-  if (w->params() == nullptr || static_cast<int64_t>(w->params()->size()) != expected || w->bound() > kMaxBound) {
-    note_malformed("PolicyWeights: parameter count does not match the widths, or an unknown bound");
-    return nullptr;
+  if (policy == nullptr || algorithm != policy_algorithm) {
+    // Only on the first weights (or a learner restarted with another algorithm): not per step.
+    const ActingPolicyRegistration* r = acting_policy_registry().find(algorithm);
+    if (r == nullptr) {
+      note_malformed("PolicyWeights: an algorithm this actor's build has no acting policy for");
+      return nullptr;
+    }
+    pending_policy = r->make(obs_dim, space);
+    pending_algorithm.assign(algorithm);
+  } else {
+    pending_policy.reset();
   }
-  const float* p = w->params()->data();
-  if (!std::all_of(p, p + expected, [](float v) { return std::isfinite(v); })) {
-    note_malformed("PolicyWeights: a parameter is not finite");
+  const ActingPolicy& judge = pending_policy != nullptr ? *pending_policy : *policy;
+  if (const char* why = judge.check(weights_networks, w->bound()); why != nullptr) {
+    note_malformed(why);
     return nullptr;
   }
   return w;
@@ -606,25 +623,24 @@ void ActorLoop::Impl::poll_weights() {
 }
 
 void ActorLoop::Impl::apply_weights(const wire::PolicyWeights* w) {
-  const auto* widths = w->widths();
-  bool same_shape = policy != nullptr && policy->widths().size() == widths->size();
-  for (flatbuffers::uoffset_t l = 0; same_shape && l < widths->size(); ++l) {
-    same_shape = policy->widths()[l] == widths->Get(l);
-  }
   const bool first = policy == nullptr;
-  if (!same_shape) {
-    // Only on the first weights (or a learner restarted with other hidden widths): not per step.
-    policy = std::make_unique<Mlp<float>>(std::vector<int>(widths->begin(), widths->end()), 1);
+  std::string_view algorithm;
+  weights_networks = wire::policy_networks(*w, algorithm);
+  if (policy == nullptr || algorithm != policy_algorithm) {  // check_weights found its acting policy
+    policy = pending_policy != nullptr && pending_algorithm == algorithm
+                 ? std::move(pending_policy)
+                 : acting_policy_registry().find(algorithm)->make(obs_dim, space);
+    policy_algorithm.assign(algorithm);
   }
-  std::copy_n(w->params()->data(), w->params()->size(), policy->params().data());
-  squash_output = w->bound() == kBoundSquashing;
+  pending_policy.reset();
+  policy->load(weights_networks, w->bound());
   weights_version = w->version();
   updates = w->updates();
   counters.weights_version.store(static_cast<int64_t>(weights_version), std::memory_order_relaxed);
   update_epsilon();
   if (first) {
-    log::info("actor {}: first weights (version {}, {} learner updates, {} parameters); epsilon {:.3f}", actor_index,
-              weights_version, updates, policy->num_params(), eps);
+    log::info("actor {}: first weights ({}, version {}, {} learner updates, {} parameters); epsilon {:.3f}",
+              actor_index, policy_algorithm, weights_version, updates, policy->num_params(), eps);
   }
 }
 

@@ -249,22 +249,23 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
         std::to_string(env->observation_size()) +
         (use_embedded ? " (" + use_embedded(embedded) + " gives the embedded width)" : std::string()));
   }
-  Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
-  load_checkpoint(o.checkpoint, ddpg);
+  const std::unique_ptr<Algorithm> algorithm =
+      make_learner(c, env->observation_size(), env->action_space(), c.seed, UpdateDevice::kCpu);
+  load_checkpoint(o.checkpoint, *algorithm);
   const bool actor_given = cmd.count("--actor") > 0;
-  if (actor_given && o.actor == ActorCopy::kAverage && !ddpg.averages_actor()) {
+  if (actor_given && o.actor == ActorCopy::kAverage && algorithm->evaluated_copy() != ActorCopy::kAverage) {
     throw std::runtime_error("--actor average: " + o.checkpoint +
                              " keeps no actor average (its run had ddpg.actor_average_tau = 0); use --actor online "
                              "or target");
   }
   // By default the copy its run's evaluations judged (and best.ckpt was chosen by).
-  const ActorCopy copy = actor_given ? o.actor : evaluated_copy(ddpg);
+  const ActorCopy copy = actor_given ? o.actor : algorithm->evaluated_copy();
   if (!actor_given && copy == ActorCopy::kAverage) {
     std::fprintf(stderr,
                  "eval: %s plays its actor average (ddpg.actor_average_tau = %g; --actor online for the other)\n",
                  o.checkpoint.c_str(), c.ddpg.actor_average_tau);
   }
-  GreedyActorPolicy policy(ddpg, env->action_space(), resolve_exploration(c, env->action_space()), copy);
+  GreedyActorPolicy policy(*algorithm, env->action_space(), resolve_exploration(c, env->action_space()), copy);
   if (o.agreement) {
     if (!gives_embedded_features(c.env)) {
       throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
@@ -277,7 +278,7 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
     print_result("scripted", evaluate_with_progress(std::move(env), shadowed, o), o.json, &tally, o.checkpoint);
     return;
   }
-  print_result("ddpg", evaluate_with_progress(std::move(env), policy, o), o.json);
+  print_result(std::string(algorithm->name()), evaluate_with_progress(std::move(env), policy, o), o.json);
 }
 
 void run_eval(const EvalOptions& o, const CLI::App& cmd) {

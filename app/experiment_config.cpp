@@ -96,6 +96,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
   v.integer("replay.shards", c.replay.shards, 1, 1024);
 
+  v.choice("train.algorithm", c.train.algorithm, algorithm_choices());
   v.integer("train.max_updates", c.train.max_updates, 0, INT64_MAX);
   v.integer("train.max_episodes", c.train.max_episodes, 0, INT64_MAX);
   v.real("train.max_seconds", c.train.max_seconds, 0.0, 1e9);
@@ -482,6 +483,17 @@ const Choices<hfo::BodyAtReset>& body_at_reset_choices() {
   return hfo::body_at_reset_names();
 }
 
+const Choices<std::string>& algorithm_choices() {
+  static const Choices<std::string> kChoices = [] {
+    Choices<std::string> c;
+    for (const AlgorithmRegistration& r : algorithm_registry().all()) {
+      c.emplace_back(r.name, r.name);
+    }
+    return c;
+  }();
+  return kChoices;
+}
+
 const Choices<std::string>& env_choices() {
   static const Choices<std::string> kChoices = [] {
     Choices<std::string> c;
@@ -540,6 +552,17 @@ std::string to_toml(const ExperimentConfig& config) {
   std::ostringstream ss;
   ss << w.root << "\n";
   return ss.str();
+}
+
+std::unique_ptr<Algorithm> make_learner(const ExperimentConfig& config, int obs_dim, const ActionSpace& space,
+                                        uint64_t seed, std::optional<UpdateDevice> device) {
+  AlgorithmArgs args;
+  args.obs_dim = obs_dim;
+  args.space = &space;
+  args.ddpg = &config.ddpg;
+  args.seed = seed;
+  args.device = device.value_or(config.ddpg.device);
+  return make_algorithm(config.train.algorithm, args);
 }
 
 }  // namespace pamdp::app

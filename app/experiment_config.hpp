@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/registry.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/training_run.hpp"
 
@@ -97,7 +100,8 @@ using Choices = std::vector<std::pair<std::string, E>>;
 const Choices<hfo::StartDistribution>& start_choices();
 const Choices<hfo::Referee>& referee_choices();
 const Choices<hfo::BodyAtReset>& body_at_reset_choices();
-const Choices<std::string>& env_choices();  // the registered envs' names
+const Choices<std::string>& env_choices();        // the registered envs' names
+const Choices<std::string>& algorithm_choices();  // the registered algorithms' names
 const Choices<hfo::ShotAim>& shot_aim_choices();
 
 // Loads `path` (empty: defaults) and applies overrides ("ddpg.gamma=0.95"). Throws
@@ -106,5 +110,10 @@ ExperimentConfig load_experiment_config(const std::string& path, const std::vect
 ExperimentConfig parse_experiment_config(const std::string& toml_text, const std::string& source_name,
                                          const std::vector<std::string>& overrides);
 std::string to_toml(const ExperimentConfig& config);
+
+// The run's learner (train.algorithm) for an env's shapes. `device` overrides ddpg.device: kCpu
+// for a learner that only acts (pamdp eval, the Python bindings).
+std::unique_ptr<Algorithm> make_learner(const ExperimentConfig& config, int obs_dim, const ActionSpace& space,
+                                        uint64_t seed, std::optional<UpdateDevice> device = std::nullopt);
 
 }  // namespace pamdp::app

@@ -26,7 +26,6 @@
 #include "core/transport.hpp"
 #include "learner/learner_server.hpp"
 #include "learner/training_run.hpp"
-#include "learner/update_backend.hpp"
 
 namespace pamdp::app {
 namespace {
@@ -85,8 +84,7 @@ void run_learner(const LearnerCliOptions& o) {
   auto env = make_env(c.env);
   auto eval_env = make_eval_env(c);
   const ExplorationConfig exploration = resolve_exploration(c, env->action_space());
-  Ddpg ddpg(env->observation_size(), env->action_space(), c.ddpg, c.seed);
-  const std::unique_ptr<UpdateBackend> backend = make_update_backend(ddpg, c.ddpg.device);
+  const std::unique_ptr<Algorithm> algorithm = make_learner(c, env->observation_size(), env->action_space(), c.seed);
   RunSpec spec;
   spec.dir = run_dir;
   spec.role = "learner";
@@ -97,14 +95,14 @@ void run_learner(const LearnerCliOptions& o) {
   spec.extra_metric_columns = {"samples_per_s",      "shards", "actors_joined", "weights_version", "malformed_messages",
                                "waiting_for_data_ms"};
   // With cloning, metrics.csv also says how much of it the Q-filter lets through (as train's).
-  const bool clones = c.ddpg.demo_bc_weight > 0.0;
+  const bool clones = algorithm->clones_demonstrations();
   if (clones) {
     spec.extra_metric_columns.insert(spec.extra_metric_columns.end(), {"bc_accepted_fraction", "bc_loss"});
   }
   // Actors played the episodes reported after the last checkpoint, and their transitions are in
   // the replay shards: their rows stay, and the next episodes are numbered after them.
   spec.keeps_episodes_after_checkpoint = true;
-  TrainingRun run(spec, ddpg, *backend, *env, *eval_env);
+  TrainingRun run(spec, *algorithm, *env, *eval_env);
   const CheckpointMeta meta = run.start(resume);
 
   LearnerServerConfig sc;
@@ -134,7 +132,7 @@ void run_learner(const LearnerCliOptions& o) {
     sc.curve_client = keys.client;
     auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
   }
-  LearnerServer server(ctx, *backend, sc);
+  LearnerServer server(ctx, *algorithm, sc);
   g_server = &server;
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);
@@ -153,12 +151,12 @@ void run_learner(const LearnerCliOptions& o) {
     run.record_episode({e.status, e.ret, e.steps, e.actor_id, e.policy_version, e.scripted});
   };
   server.on_update = [&](const UpdateStats& s) {
-    learner_metrics.on_update(s, ddpg.updates());
+    learner_metrics.on_update(s, algorithm->updates());
     run.record_update(s);
     run.evaluate_if_due();
   };
   server.on_tick = [&](const LearnerCounters& k) {
-    learner_metrics.on_tick(k, ddpg.updates(), server.metrics_urls().size());
+    learner_metrics.on_tick(k, algorithm->updates(), server.metrics_urls().size());
     if (run.checkpoint_due()) {
       run.save();
     }
@@ -203,7 +201,7 @@ void run_learner(const LearnerCliOptions& o) {
   run.finish();
   g_server = nullptr;
   std::printf("learner stopped: %lld updates, %lld episodes; checkpoint %s/checkpoint.ckpt\n",
-              static_cast<long long>(ddpg.updates()), static_cast<long long>(run.episodes()), run_dir.c_str());
+              static_cast<long long>(algorithm->updates()), static_cast<long long>(run.episodes()), run_dir.c_str());
 }
 
 }  // namespace

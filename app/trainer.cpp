@@ -19,10 +19,9 @@
 #include "app/run_support.hpp"
 #include "core/log.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/checkpoint.hpp"
-#include "learner/ddpg.hpp"
 #include "learner/training_run.hpp"
-#include "learner/update_backend.hpp"
 #include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"
 #include "replay/replay_snapshot.hpp"
@@ -43,8 +42,7 @@ class Trainer {
         exploration_(resolve_exploration(c, space_)),
         obs_dim_(env_->observation_size()),
         width_(space_.output_width()),
-        ddpg_(obs_dim_, space_, c.ddpg, mix_seeds(c.seed, 1)),
-        backend_(make_update_backend(ddpg_, c.ddpg.device)),
+        algorithm_(make_learner(c, obs_dim_, space_, mix_seeds(c.seed, 1))),
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
         demo_(c.demo_shot),
@@ -55,8 +53,9 @@ class Trainer {
         next_obs_(static_cast<size_t>(obs_dim_)),
         net_out_(static_cast<size_t>(width_)),
         stored_(static_cast<size_t>(width_)),
-        run_(run_spec(c, o_.run_dir, exploration_, c.ddpg.demo_bc_weight > 0.0), ddpg_, *backend_, *env_, *eval_env_) {
-    if (c.ddpg.demo_bc_weight > 0.0) {
+        run_(run_spec(c, o_.run_dir, exploration_, algorithm_->clones_demonstrations()), *algorithm_, *env_,
+             *eval_env_) {
+    if (algorithm_->clones_demonstrations()) {
       demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
       demo_batch_.emplace(obs_dim_, width_, c.ddpg.batch_size);
       if (c.exploration.demo_relabel) {
@@ -100,15 +99,15 @@ class Trainer {
   ExplorationConfig exploration_;
   int obs_dim_;
   int width_;
-  Ddpg ddpg_;
-  // Runs the updates (CPU or GPU). With the GPU the host actor that acts here is refreshed from
-  // the device every cluster.publish_every_updates updates (the staleness distributed actors
-  // see) and at every episode end, a schedule fixed by update and episode counts, so a resumed
-  // run still replays the same actions; on the CPU every sync is a no-op.
-  std::unique_ptr<UpdateBackend> backend_;
+  // The learner (train.algorithm), updating on the CPU or GPU. With the GPU the host policy that
+  // acts here is refreshed from the device every cluster.publish_every_updates updates (the
+  // staleness distributed actors see) and at every episode end, a schedule fixed by update and
+  // episode counts, so a resumed run still replays the same actions; on the CPU every sync is a
+  // no-op.
+  std::unique_ptr<Algorithm> algorithm_;
   ReplayBuffer replay_;
-  // With ddpg.demo_bc_weight > 0: the demonstrated transitions again, kept for cloning (they
-  // also go into replay_); the backend is then the CPU one (make_update_backend).
+  // When the learner clones (ddpg.demo_bc_weight > 0): the demonstrated transitions again, kept
+  // for cloning (they also go into replay_).
   std::optional<ReplayBuffer> demo_replay_;
   std::optional<BatchBuffers> demo_batch_;
   // With exploration.demo_relabel: the agent's steps of the running episode with the scripted
@@ -131,7 +130,7 @@ bool Trainer::should_stop() const {
   if (o_.stop != nullptr && o_.stop->load()) {
     return true;
   }
-  if (ddpg_.updates() >= c_.train.max_updates) {
+  if (algorithm_->updates() >= c_.train.max_updates) {
     return true;
   }
   if (c_.train.max_episodes > 0 && run_.episodes() >= c_.train.max_episodes) {
@@ -227,7 +226,8 @@ TrainSummary Trainer::run() {
     env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())), obs_);
     episode_.clear();
     // The draw is skipped when demonstrations are off, so runs without them keep their streams.
-    const double share = demo_share(ddpg_.updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
+    const double share =
+        demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
     const bool demo = share > 0.0 && explore_.rng().uniform() < share;
     const bool label = labelled_ && !demo;  // the agent plays, its steps get the teacher's labels
     if (demo || label) {
@@ -237,9 +237,9 @@ TrainSummary Trainer::run() {
     int steps = 0;
     StepResult sr;
     do {
-      const double eps = linear_epsilon(ddpg_.updates(), exploration_.epsilon_start, exploration_.epsilon_end,
+      const double eps = linear_epsilon(algorithm_->updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                         exploration_.epsilon_anneal_updates);
-      ddpg_.act(obs_, net_out_);
+      algorithm_->act(obs_, net_out_);
       const int id = demo ? demo_action(stored_) : explore_.select(net_out_, eps, stored_);
       if (label) {
         demo_action(label_);  // before the step: the label is for the state the agent acted in
@@ -265,16 +265,17 @@ TrainSummary Trainer::run() {
         const int B = c_.ddpg.batch_size;
         if (demo_replay_ && demo_replay_->size() > 0) {
           demo_replay_->sample(sample_rng_, B, *demo_batch_);
-          run_.record_update(backend_->update(view_of(batch_), view_of(*demo_batch_)));
+          const BatchView demos = view_of(*demo_batch_);
+          run_.record_update(algorithm_->update(view_of(batch_), &demos));
         } else {
-          run_.record_update(backend_->update(view_of(batch_)));
+          run_.record_update(algorithm_->update(view_of(batch_)));
         }
         if (o_.metrics != nullptr) {
-          o_.metrics->on_update(run_.last_update(), ddpg_.updates(), B);
+          o_.metrics->on_update(run_.last_update(), algorithm_->updates(), B);
         }
         update_credit_ -= 1.0;
-        if (ddpg_.updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {
-          backend_->sync_actor_to_host();
+        if (algorithm_->updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {
+          algorithm_->sync_acting();
         }
       }
       if (replay_.size() < c_.replay.warmup) {
@@ -287,14 +288,15 @@ TrainSummary Trainer::run() {
     if (label) {
       flush_episode(*labelled_, c_.ddpg.gamma, *demo_replay_);
     }
-    backend_->sync_actor_to_host();
+    algorithm_->sync_acting();
     if (o_.metrics != nullptr) {
       o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()), !demo);
     }
     // One process: always the newest weights; none (0) for an episode the scripted offense played.
-    run_.record_episode({sr.status, ep_return, steps, 0, demo ? 0 : static_cast<uint64_t>(ddpg_.updates()), demo});
+    run_.record_episode(
+        {sr.status, ep_return, steps, 0, demo ? 0 : static_cast<uint64_t>(algorithm_->updates()), demo});
     if (bar_) {
-      bar_->update(ddpg_.updates());
+      bar_->update(algorithm_->updates());
     }
     if (run_.evaluate_if_due()) {
       log_tick(true);
@@ -313,7 +315,7 @@ TrainSummary Trainer::run() {
     s.final_eval = *run_.last_eval();
   }
   log_tick(true);
-  s.updates = ddpg_.updates();
+  s.updates = algorithm_->updates();
   s.env_steps = run_.env_steps();
   s.episodes = run_.episodes();
   s.seconds = run_.elapsed();

@@ -141,11 +141,40 @@ void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id
 }
 
 void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
-                          std::span<const int> widths, uint8_t bound, std::span<const float> params) {
+                          std::string_view algorithm, uint8_t bound, std::span<const NetworkView> networks) {
   fbb.Clear();
-  const auto w = fbb.CreateVector(widths.data(), widths.size());
-  const auto p = fbb.CreateVector(params.data(), params.size());
-  finish(fbb, Payload::PolicyWeights, CreatePolicyWeights(fbb, version, updates, w, bound, p).Union());
+  std::vector<flatbuffers::Offset<NamedNetwork>> nets;
+  nets.reserve(networks.size());
+  for (const NetworkView& n : networks) {
+    const auto name = fbb.CreateString(n.name.data(), n.name.size());
+    const auto w = fbb.CreateVector(n.widths.data(), n.widths.size());
+    const auto p = fbb.CreateVector(n.params.data(), n.params.size());
+    nets.push_back(CreateNamedNetwork(fbb, name, w, p));
+  }
+  const auto list = fbb.CreateVector(nets);
+  const auto name = fbb.CreateString(algorithm.data(), algorithm.size());
+  finish(fbb, Payload::PolicyWeights, CreatePolicyWeights(fbb, version, updates, {}, bound, {}, name, list).Union());
+}
+
+std::vector<NetworkView> policy_networks(const PolicyWeights& w, std::string_view& algorithm) {
+  const auto view = [](const flatbuffers::String* name, const flatbuffers::Vector<int32_t>* widths,
+                       const flatbuffers::Vector<float>* params, std::string_view fallback) {
+    return NetworkView{
+        name != nullptr ? std::string_view(name->c_str(), name->size()) : fallback,
+        widths != nullptr ? std::span<const int>(widths->data(), widths->size()) : std::span<const int>(),
+        params != nullptr ? std::span<const float>(params->data(), params->size()) : std::span<const float>()};
+  };
+  std::vector<NetworkView> out;
+  if (w.networks() != nullptr) {
+    algorithm = w.algorithm() != nullptr ? std::string_view(w.algorithm()->c_str(), w.algorithm()->size()) : "";
+    for (const NamedNetwork* n : *w.networks()) {
+      out.push_back(view(n->name(), n->widths(), n->params(), ""));
+    }
+  } else if (w.widths() != nullptr) {
+    algorithm = "ddpg";
+    out.push_back(view(nullptr, w.widths(), w.params(), "actor"));
+  }
+  return out;
 }
 
 void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,

@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/network_view.hpp"
 #include "schemas/messages_generated.h"
 
 namespace pamdp::wire {
@@ -63,8 +65,13 @@ void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_
                           uint32_t demo_batch_size = 0);
 void build_sample_reply(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, const TransitionRows& rows,
                         const TransitionRows* demos = nullptr);
+// `algorithm` names the acting policy the actors build from `networks` (actor/acting_policy.hpp).
 void build_policy_weights(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, int64_t updates,
-                          std::span<const int> widths, uint8_t bound, std::span<const float> params);
+                          std::string_view algorithm, uint8_t bound, std::span<const NetworkView> networks);
+// The networks of a verified PolicyWeights as views into it: its named networks, or a message
+// from a learner before the algorithm seam read as DDPG's actor. `algorithm` receives the name
+// ("ddpg" for the older messages). Empty when it carries none.
+std::vector<NetworkView> policy_networks(const PolicyWeights& w, std::string_view& algorithm);
 void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t episode, float ret,
                           uint32_t steps, int32_t status, uint64_t policy_version, bool scripted = false);
 void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,

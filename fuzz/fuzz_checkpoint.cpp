@@ -18,20 +18,22 @@
 #include "envs/toy/reach_stop.hpp"
 #include "fuzz/scratch_file.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/ddpg_algorithm.hpp"
 
 namespace {
 
 struct Learner {
   pamdp::toy::ReachStopEnv env;
-  std::unique_ptr<pamdp::Ddpg> ddpg;
+  std::unique_ptr<pamdp::DdpgAlgorithm> ddpg;
   Learner() {
     pamdp::DdpgConfig config;
     config.hidden = {8, 8};  // fuzz_seeds writes its checkpoints with these widths
-    ddpg = std::make_unique<pamdp::Ddpg>(env.observation_size(), env.action_space(), config, 1);
+    ddpg = std::make_unique<pamdp::DdpgAlgorithm>(env.observation_size(), env.action_space(), config, 1,
+                                                  pamdp::UpdateDevice::kCpu);
   }
 };
 
-void load(const std::string& path, const uint8_t* data, size_t size, pamdp::Ddpg& ddpg) {
+void load(const std::string& path, const uint8_t* data, size_t size, pamdp::Algorithm& ddpg) {
   if (FILE* f = std::fopen(path.c_str(), "wb")) {
     std::fwrite(data, 1, size, f);
     std::fclose(f);

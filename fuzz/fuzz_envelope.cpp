@@ -113,6 +113,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
         g_sink = g_sink + static_cast<uint64_t>(sum != 0.0F);
       }
+      // What an actor reads of it (actor/actor_loop.cpp): the named networks as views.
+      std::string_view algorithm;
+      for (const pamdp::NetworkView& n : pamdp::wire::policy_networks(*m, algorithm)) {
+        g_sink = g_sink + n.name.size() + n.widths.size() + n.params.size() +
+                 static_cast<uint64_t>(!n.widths.empty() && n.widths.back() != 0) +
+                 static_cast<uint64_t>(!n.params.empty() && n.params.back() != 0.0F);
+      }
+      g_sink = g_sink + algorithm.size();
       break;
     }
     case Payload::EpisodeReport: {

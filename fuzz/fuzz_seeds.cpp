@@ -12,6 +12,7 @@
 #include "core/wire.hpp"
 #include "envs/toy/reach_stop.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/ddpg_algorithm.hpp"
 #include "replay/replay_snapshot.hpp"
 
 namespace fs = std::filesystem;
@@ -65,7 +66,8 @@ int main(int argc, char** argv) {
   write(env_dir / "sample_reply", fbb);
   const std::vector<int> widths = {3, 8, 4};
   std::vector<float> params(3 * 8 + 8 + 8 * 4 + 4, 0.1F);
-  wire::build_policy_weights(fbb, 4, 1000, widths, 0, params);
+  const NetworkView actor{"actor", widths, params};
+  wire::build_policy_weights(fbb, 4, 1000, "ddpg", 0, {&actor, 1});
   write(env_dir / "policy_weights", fbb);
   wire::build_episode_report(fbb, 1, 10, 0.5F, 20, 1, 4);
   write(env_dir / "episode_report", fbb);
@@ -88,7 +90,7 @@ int main(int argc, char** argv) {
   toy::ReachStopEnv env;
   DdpgConfig config;
   config.hidden = {8, 8};
-  Ddpg ddpg(env.observation_size(), env.action_space(), config, 1);
+  DdpgAlgorithm ddpg(env.observation_size(), env.action_space(), config, 1, UpdateDevice::kCpu);
   CheckpointMeta meta;
   meta.config_toml = "seed = 1\n[env]\nname = \"reach_stop\"\n[ddpg]\nhidden = [8, 8]\n";
   meta.env_steps = 100;

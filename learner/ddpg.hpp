@@ -25,12 +25,10 @@
 #include "core/mlp.hpp"
 #include "core/optim.hpp"
 #include "core/rng.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/gradient_bounds.hpp"
 
 namespace pamdp {
-
-// Where update() runs (learner/update_backend.hpp): kAuto takes a CUDA device when one is present.
-enum class UpdateDevice { kAuto, kCpu, kCuda };
 
 struct DdpgConfig {
   std::vector<int> hidden = {1024, 512, 256, 128};  // both networks, as in the paper
@@ -61,35 +59,6 @@ struct DdpgConfig {
   // quality swings by several points between evaluations; its average over a long window plays
   // steadier (Polyak & Juditsky 1992; for deep RL, Nikishin et al. 2018). 0 disables.
   double actor_average_tau = 0.0;
-};
-
-// Which copy of the actor plays: the one training moves, the critic targets' soft-updated copy
-// (rate tau), or the evaluation average (rate actor_average_tau).
-enum class ActorCopy { kOnline, kTarget, kAverage };
-
-// A minibatch, one sample per column. Not owned.
-struct BatchView {
-  Eigen::Map<const Eigen::MatrixXf> states;       // obs x B
-  Eigen::Map<const Eigen::MatrixXf> actions;      // (num_actions + num_params) x B, as stored
-  Eigen::Map<const Eigen::VectorXf> rewards;      // B
-  Eigen::Map<const Eigen::MatrixXf> next_states;  // obs x B
-  Eigen::Map<const Eigen::VectorXf> terminal;     // B, 1 if the episode ended at this transition
-  Eigen::Map<const Eigen::VectorXf> mc_returns;   // B (read only when mc_mix > 0)
-};
-
-struct UpdateStats {
-  float critic_loss = 0.0F;  // (1 / 2B) sum (Q - y)^2
-  float q_mean = 0.0F;
-  float target_mean = 0.0F;
-  float critic_grad_norm = 0.0F;  // before clipping
-  float actor_grad_norm = 0.0F;
-  // Continuous parameters of the batch's actor outputs at or past a bound of their range (a
-  // health check of the gradient bounding; W x B compares).
-  float params_at_bound_fraction = 0.0F;
-  // With demonstrations: the share of them the Q-filter let through, and their cloning loss
-  // (demo_bc_weight * mean over the demonstrations of 1/2 |pi(s_d) - a_d|^2, filtered ones 0).
-  float bc_accepted_fraction = 0.0F;
-  float bc_loss = 0.0F;
 };
 
 class Ddpg {

@@ -34,10 +34,9 @@ int64_t ms_since(Clock::time_point t) {
 
 }  // namespace
 
-LearnerServer::LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerServerConfig config)
+LearnerServer::LearnerServer(net::Context& ctx, Algorithm& algorithm, LearnerServerConfig config)
     : ctx_(ctx),
-      backend_(backend),
-      ddpg_(backend.ddpg()),
+      algorithm_(algorithm),
       config_(std::move(config)),
       join_(ctx, net::SocketType::kRouter),
       weights_(ctx, net::SocketType::kPub),
@@ -79,13 +78,13 @@ void LearnerServer::send_map(std::span<const uint8_t> identity, uint32_t actor_i
 }
 
 void LearnerServer::publish_weights() {
-  backend_.sync_actor_to_host();  // and moves the actor average
-  Mlp<float>& actor = ddpg_.actor();
+  algorithm_.sync_acting();  // and moves an evaluation average
+  const ActingWeights acting = algorithm_.acting_weights();
   ++counters_.weights_version;
-  wire::build_policy_weights(fbb_->weights, static_cast<uint64_t>(counters_.weights_version), ddpg_.updates(),
-                             actor.widths(), static_cast<uint8_t>(ddpg_.config().bound), actor.params());
+  wire::build_policy_weights(fbb_->weights, static_cast<uint64_t>(counters_.weights_version), algorithm_.updates(),
+                             acting.algorithm, acting.bound, acting.networks);
   weights_.send(wire::bytes_of(fbb_->weights), 0);
-  last_published_at_ = ddpg_.updates();
+  last_published_at_ = algorithm_.updates();
 }
 
 void LearnerServer::handle_join_socket() {
@@ -228,7 +227,7 @@ void LearnerServer::refresh_peers(bool drop_silent) {
 
 void LearnerServer::request_samples(Shard& shard) {
   while (shard.in_flight < config_.requests_in_flight_per_shard) {
-    const auto B = static_cast<uint32_t>(ddpg_.config().batch_size);
+    const auto B = static_cast<uint32_t>(algorithm_.batch_size());
     wire::build_sample_request(fbb_->fbb, next_request_id_++, B, config_.clone_demos ? B : 0);
     if (!shard.dealer.send(wire::bytes_of(fbb_->fbb), 0)) {
       return;
@@ -257,9 +256,9 @@ BatchView view_of(const wire::TransitionRows& rows, std::vector<float>& terminal
 
 void LearnerServer::handle_shard(Shard& shard) {
   net::Message& msg = reply_;  // reused: its aligned copy buffer grows once
-  const auto obs = static_cast<uint32_t>(ddpg_.obs_dim());
-  const auto act = static_cast<uint32_t>(ddpg_.output_width());
-  const int B = ddpg_.config().batch_size;
+  const auto obs = static_cast<uint32_t>(algorithm_.obs_dim());
+  const auto act = static_cast<uint32_t>(algorithm_.output_width());
+  const int B = algorithm_.batch_size();
   std::vector<float>& terminal = terminal_scratch_;
   // At most one reply per call: the run loop alternates shards and the join socket, so
   // heartbeats and episode reports are answered between updates.
@@ -287,10 +286,11 @@ void LearnerServer::handle_shard(Shard& shard) {
     const BatchView view = view_of(wire::rows_of(b), terminal);
     UpdateStats stats;
     if (d != nullptr) {
-      stats = backend_.update(view, view_of(wire::rows_of(d), demo_terminal_scratch_));
+      const BatchView demos = view_of(wire::rows_of(d), demo_terminal_scratch_);
+      stats = algorithm_.update(view, &demos);
       counters_.demo_samples_received += B;
     } else {
-      stats = backend_.update(view);
+      stats = algorithm_.update(view);
     }
     ++counters_.updates;
     counters_.samples_received += B;
@@ -298,10 +298,10 @@ void LearnerServer::handle_shard(Shard& shard) {
     if (on_update) {
       on_update(stats);
     }
-    if (ddpg_.updates() - last_published_at_ >= config_.publish_every_updates) {
+    if (algorithm_.updates() - last_published_at_ >= config_.publish_every_updates) {
       publish_weights();
     }
-    if (stop_.load() || ddpg_.updates() >= config_.max_updates) {
+    if (stop_.load() || algorithm_.updates() >= config_.max_updates) {
       return;
     }
   }
@@ -328,13 +328,13 @@ void LearnerServer::shards_changed() {
 }
 
 void LearnerServer::run() {
-  terminal_scratch_.assign(static_cast<size_t>(ddpg_.config().batch_size), 0.0F);
-  demo_terminal_scratch_.assign(static_cast<size_t>(ddpg_.config().batch_size), 0.0F);
+  terminal_scratch_.assign(static_cast<size_t>(algorithm_.batch_size()), 0.0F);
+  demo_terminal_scratch_.assign(static_cast<size_t>(algorithm_.batch_size()), 0.0F);
   const auto start = Clock::now();
   auto last_tick = start;
   auto waiting_since = Clock::now();
   bool waiting = false;
-  last_published_at_ = ddpg_.updates();
+  last_published_at_ = algorithm_.updates();
   publish_weights();
   metrics_urls_.clear();
   if (!config_.metrics_url.empty()) {
@@ -346,7 +346,7 @@ void LearnerServer::run() {
   net::Poller poller;
   uint64_t poller_version = 0;
   log::info("learner: join {} weights {}", join_endpoint_, weights_endpoint_);
-  while (!stop_.load() && ddpg_.updates() < config_.max_updates) {
+  while (!stop_.load() && algorithm_.updates() < config_.max_updates) {
     if (config_.max_seconds > 0.0 &&
         std::chrono::duration<double>(Clock::now() - start).count() >= config_.max_seconds) {
       break;
@@ -359,7 +359,7 @@ void LearnerServer::run() {
       }
       poller_version = map_version_;
     }
-    const int64_t before = ddpg_.updates();
+    const int64_t before = algorithm_.updates();
     const size_t polled = shards_.size();
     poller.poll(20);
     // Shards first: handling the join socket may add or replace shards.
@@ -380,7 +380,7 @@ void LearnerServer::run() {
       publish_weights();
     }
     // Waiting-for-data accounting: no update in this round although we tried.
-    if (ddpg_.updates() == before) {
+    if (algorithm_.updates() == before) {
       if (!waiting) {
         waiting = true;
         waiting_since = Clock::now();

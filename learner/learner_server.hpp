@@ -1,12 +1,12 @@
 // The learner role of the distributed system (docs/protocol.md): binds the join socket
 // (ROUTER) and the weights broadcast (PUB), hands out the cluster map, keeps several sample
-// requests in flight on every replay shard, runs DDPG updates on the replies, publishes weights
+// requests in flight on every replay shard, runs the algorithm's updates on the replies, publishes weights
 // every N updates, and collects episode reports.
 //
 // One thread runs run(); stop() may be called from any thread or a signal handler. Received
 // buffers are verified before use; a bad message is counted and dropped. The update path reads
 // sampled rows in place from the received buffers (row-major rows are the column-major
-// obs x batch matrices Ddpg wants), so it copies nothing per sample.
+// obs x batch matrices the update wants), so it copies nothing per sample.
 #pragma once
 
 #include <atomic>
@@ -21,8 +21,7 @@
 #include <vector>
 
 #include "core/transport.hpp"
-#include "learner/ddpg.hpp"
-#include "learner/update_backend.hpp"
+#include "learner/algorithm.hpp"
 
 namespace pamdp {
 
@@ -45,7 +44,7 @@ struct LearnerServerConfig {
   int64_t weights_version = 0;                       // last version published (a resumed run goes on from it)
   // Cloning (ddpg.demo_bc_weight > 0): every sample request also asks for a batch from the
   // shards' demonstration table, and an update whose reply carries one clones it
-  // (UpdateBackend::update(batch, demos)); until a shard holds demonstrations, plain updates.
+  // (Algorithm::update(batch, &demos)); until a shard holds demonstrations, plain updates.
   bool clone_demos = false;
 };
 
@@ -75,9 +74,9 @@ struct EpisodeSummary {
 
 class LearnerServer {
  public:
-  // `backend` (and its Ddpg) are owned by the caller and must outlive the server. Updates go
-  // through the backend; weights are synced to the host Ddpg before each broadcast.
-  LearnerServer(net::Context& ctx, UpdateBackend& backend, LearnerServerConfig config);
+  // `algorithm` is owned by the caller and must outlive the server. Its acting networks are
+  // synced to the host before each broadcast.
+  LearnerServer(net::Context& ctx, Algorithm& algorithm, LearnerServerConfig config);
   ~LearnerServer();
 
   // Resolved, connectable endpoints (valid after construction).
@@ -125,8 +124,7 @@ class LearnerServer {
   void note_malformed(const char* what);
 
   net::Context& ctx_;
-  UpdateBackend& backend_;
-  Ddpg& ddpg_;
+  Algorithm& algorithm_;
   LearnerServerConfig config_;
   net::Socket join_;
   net::Socket weights_;

@@ -40,34 +40,32 @@ double RecentEpisodes::mean_steps() const {
   return window_mean(window_, [](const Episode& e) { return static_cast<double>(e.steps); });
 }
 
-TrainingRun::TrainingRun(RunSpec spec, Ddpg& ddpg, UpdateBackend& backend, const Env& env, Env& eval_env)
-    : spec_(std::move(spec)), ddpg_(ddpg), backend_(backend), env_(env), eval_env_(eval_env) {}
+TrainingRun::TrainingRun(RunSpec spec, Algorithm& algorithm, const Env& env, Env& eval_env)
+    : spec_(std::move(spec)), algorithm_(algorithm), env_(env), eval_env_(eval_env) {}
 
 CheckpointMeta TrainingRun::start(bool resume) {
   fs::create_directories(spec_.dir);
   CheckpointMeta meta;
   if (resume) {
-    meta = load_checkpoint((spec_.dir / "checkpoint.ckpt").string(), ddpg_);
-    backend_.load_from_host();
+    meta = load_checkpoint((spec_.dir / "checkpoint.ckpt").string(), algorithm_);
     episodes_ = meta.episodes;
     env_steps_ = meta.env_steps;
     base_seconds_ = meta.elapsed_seconds;
   } else {
     if (!spec_.loop.init_from.empty()) {
-      warm_start_from_checkpoint(spec_.loop.init_from, ddpg_);
-      backend_.load_from_host();
+      warm_start_from_checkpoint(spec_.loop.init_from, algorithm_);
       log::info("{}: networks warm-started from {}", spec_.role, spec_.loop.init_from);
     }
     write_file_atomically((spec_.dir / "config.toml").string(), spec_.config_toml.data(), spec_.config_toml.size());
   }
-  if (ddpg_.averages_actor()) {
-    log::info("{}: evaluations and best.ckpt play the actor average (ddpg.actor_average_tau = {})", spec_.role,
-              ddpg_.config().actor_average_tau);
+  if (const std::string note = algorithm_.evaluated_copy_note(); !note.empty()) {
+    log::info("{}: {}", spec_.role, note);
   }
   std::optional<ResumePoint> resume_at;
   if (resume) {
-    resume_at = ResumePoint{
-        ddpg_.updates(), spec_.keeps_episodes_after_checkpoint ? std::nullopt : std::optional<int64_t>(meta.episodes)};
+    resume_at =
+        ResumePoint{algorithm_.updates(),
+                    spec_.keeps_episodes_after_checkpoint ? std::nullopt : std::optional<int64_t>(meta.episodes)};
   }
   logs_.emplace(spec_.dir, spec_.extra_metric_columns, resume_at);
   if (resume) {
@@ -95,10 +93,10 @@ CheckpointMeta TrainingRun::start(bool resume) {
   best_.emplace(spec_.dir / "best_eval.txt", spec_.role);
   start_ = std::chrono::steady_clock::now();
   last_checkpoint_ = last_row_ = base_seconds_;
-  row_updates_ = ddpg_.updates();
+  row_updates_ = algorithm_.updates();
   row_env_steps_ = env_steps_;
   const int64_t every = spec_.loop.eval_every_updates;
-  next_eval_ = every > 0 ? (ddpg_.updates() / every + 1) * every : INT64_MAX;
+  next_eval_ = every > 0 ? (algorithm_.updates() / every + 1) * every : INT64_MAX;
   return meta;
 }
 
@@ -108,7 +106,7 @@ double TrainingRun::elapsed() const {
 
 double TrainingRun::epsilon() const {
   const ExplorationConfig& x = spec_.exploration;
-  return linear_epsilon(ddpg_.updates(), x.epsilon_start, x.epsilon_end, x.epsilon_anneal_updates);
+  return linear_epsilon(algorithm_.updates(), x.epsilon_start, x.epsilon_end, x.epsilon_anneal_updates);
 }
 
 void TrainingRun::record_episode(const FinishedEpisode& e) {
@@ -119,7 +117,7 @@ void TrainingRun::record_episode(const FinishedEpisode& e) {
   EpisodeRow row;
   row.episode = episodes_;
   row.wall_seconds = elapsed();
-  row.updates = ddpg_.updates();
+  row.updates = algorithm_.updates();
   row.actor = e.actor;
   row.ret = e.ret;
   row.steps = e.steps;
@@ -130,7 +128,7 @@ void TrainingRun::record_episode(const FinishedEpisode& e) {
 }
 
 bool TrainingRun::evaluation_due() const {
-  return ddpg_.updates() >= next_eval_;
+  return algorithm_.updates() >= next_eval_;
 }
 
 bool TrainingRun::evaluate_if_due() {
@@ -147,9 +145,9 @@ void TrainingRun::evaluate() {
   if (loop.eval_episodes <= 0) {
     return;
   }
-  backend_.sync_actor_to_host();  // moves the actor average too, as the weight broadcasts do
-  GreedyActorPolicy policy(ddpg_, eval_env_.action_space(), spec_.exploration, evaluated_copy(ddpg_));
-  const int64_t at = ddpg_.updates();
+  algorithm_.sync_acting();  // moves the actor average too, as the weight broadcasts do
+  GreedyActorPolicy policy(algorithm_, eval_env_.action_space(), spec_.exploration, algorithm_.evaluated_copy());
+  const int64_t at = algorithm_.updates();
   last_eval_ = pamdp::evaluate(eval_env_, policy, loop.eval_episodes, screening_seed(spec_.seed, at));
   if (on_eval) {
     on_eval(*last_eval_);
@@ -172,7 +170,7 @@ MetricsRow TrainingRun::next_metrics_row() {
   const double dt = std::max(1e-9, now - last_row_);
   MetricsRow row;
   row.wall_seconds = now;
-  row.updates = ddpg_.updates();
+  row.updates = algorithm_.updates();
   row.env_steps = env_steps_;
   row.episodes = episodes_;
   row.epsilon = epsilon();
@@ -181,11 +179,11 @@ MetricsRow TrainingRun::next_metrics_row() {
   row.mean_steps_100 = recent_.mean_steps();
   row.critic_loss = last_stats_.critic_loss;
   row.q_mean = last_stats_.q_mean;
-  row.updates_per_s = static_cast<double>(ddpg_.updates() - row_updates_) / dt;
+  row.updates_per_s = static_cast<double>(algorithm_.updates() - row_updates_) / dt;
   row.env_steps_per_s = static_cast<double>(env_steps_ - row_env_steps_) / dt;
   row.eval = last_eval_;
   last_row_ = now;
-  row_updates_ = ddpg_.updates();
+  row_updates_ = algorithm_.updates();
   row_env_steps_ = env_steps_;
   return row;
 }
@@ -209,8 +207,7 @@ CheckpointMeta TrainingRun::meta_now() {
 
 void TrainingRun::save_to(const fs::path& file) {
   const CheckpointMeta meta = meta_now();
-  backend_.sync_to_host();
-  save_checkpoint(file.string(), ddpg_, meta);
+  save_checkpoint(file.string(), algorithm_, meta);
 }
 
 void TrainingRun::save() {

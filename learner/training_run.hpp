@@ -29,16 +29,16 @@
 
 #include "actor/exploration.hpp"
 #include "envs/env.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/checkpoint.hpp"
-#include "learner/ddpg.hpp"
 #include "learner/evaluation.hpp"
 #include "learner/run_logs.hpp"
-#include "learner/update_backend.hpp"
 
 namespace pamdp {
 
 // The training loop's settings (config keys train.*).
 struct TrainLoopConfig {
+  std::string algorithm = "ddpg";  // the learner (learner/algorithm.hpp's registry)
   int64_t max_updates = 3000000;
   int64_t max_episodes = 0;  // 0 = no limit
   double max_seconds = 0.0;  // 0 = no limit
@@ -100,9 +100,9 @@ struct FinishedEpisode {
 
 class TrainingRun {
  public:
-  // `ddpg` and `backend` are the learner; `env` names the outcomes; `eval_env` plays the greedy
+  // `algorithm` is the learner; `env` names the outcomes; `eval_env` plays the greedy
   // evaluations. All must outlive the run.
-  TrainingRun(RunSpec spec, Ddpg& ddpg, UpdateBackend& backend, const Env& env, Env& eval_env);
+  TrainingRun(RunSpec spec, Algorithm& algorithm, const Env& env, Env& eval_env);
 
   // A new run (resume false) or one resumed from dir/checkpoint.ckpt. Returns the checkpoint's
   // metadata (default for a new run): the caller restores its own state from it (random streams,
@@ -147,7 +147,7 @@ class TrainingRun {
   [[nodiscard]] double last_row_seconds() const { return last_row_; }
   [[nodiscard]] int64_t episodes() const { return episodes_; }
   [[nodiscard]] int64_t env_steps() const { return env_steps_; }
-  [[nodiscard]] int64_t updates() const { return ddpg_.updates(); }
+  [[nodiscard]] int64_t updates() const { return algorithm_.updates(); }
   [[nodiscard]] const RecentEpisodes& recent() const { return recent_; }
   [[nodiscard]] const UpdateStats& last_update() const { return last_stats_; }
   [[nodiscard]] const std::optional<EvalResult>& last_eval() const { return last_eval_; }
@@ -160,8 +160,7 @@ class TrainingRun {
   void save_to(const std::filesystem::path& file);
 
   RunSpec spec_;
-  Ddpg& ddpg_;
-  UpdateBackend& backend_;
+  Algorithm& algorithm_;
   const Env& env_;
   Env& eval_env_;
   std::optional<RunLogs> logs_;

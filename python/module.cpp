@@ -466,17 +466,18 @@ class PyPolicy {
       : config_(load_config(path)),
         env_(build_env(config_.env)),
         facts_(*env_),
-        ddpg_(env_->observation_size(), env_->action_space(), config_.ddpg, config_.seed),
+        learner_(app::make_learner(config_, env_->observation_size(), env_->action_space(), config_.seed,
+                                   UpdateDevice::kCpu)),
         explore_(explore) {
-    load_checkpoint(path, ddpg_);
+    load_checkpoint(path, *learner_);
     if (actor == "evaluated") {
-      copy_ = evaluated_copy(ddpg_);
+      copy_ = learner_->evaluated_copy();
     } else if (actor == "online") {
       copy_ = ActorCopy::kOnline;
     } else if (actor == "target") {
       copy_ = ActorCopy::kTarget;
     } else if (actor == "average") {
-      if (!ddpg_.averages_actor()) {
+      if (learner_->evaluated_copy() != ActorCopy::kAverage) {
         throw py::value_error("actor='average': " + path + " keeps no actor average (ddpg.actor_average_tau = 0)");
       }
       copy_ = ActorCopy::kAverage;
@@ -484,13 +485,13 @@ class PyPolicy {
       throw py::value_error("actor must be one of: evaluated, online, target, average; got '" + actor + "'");
     }
     const ExplorationConfig exploration = app::resolve_exploration(config_, env_->action_space());
-    epsilon_ = epsilon.value_or(linear_epsilon(ddpg_.updates(), exploration.epsilon_start, exploration.epsilon_end,
+    epsilon_ = epsilon.value_or(linear_epsilon(learner_->updates(), exploration.epsilon_start, exploration.epsilon_end,
                                                exploration.epsilon_anneal_updates));
     if (!(epsilon_ >= 0.0 && epsilon_ <= 1.0)) {
       throw py::value_error("epsilon must be within [0, 1], got " + std::to_string(epsilon_));
     }
     select_.emplace(env_->action_space(), exploration, seed);
-    output_.resize(static_cast<size_t>(ddpg_.output_width()));
+    output_.resize(static_cast<size_t>(learner_->output_width()));
     stored_.resize(output_.size());
   }
 
@@ -513,7 +514,7 @@ class PyPolicy {
     }
     for (py::ssize_t b = 0; b < batch; ++b) {
       const std::span<const float> row(obs.data() + b * width, static_cast<size_t>(width));
-      ddpg_.act(row, output_, copy_);
+      learner_->act(row, output_, copy_);
       int id = 0;
       const float* chosen = output_.data() + na;
       if (explore_) {
@@ -542,7 +543,7 @@ class PyPolicy {
   }
 
   [[nodiscard]] const app::ExperimentConfig& config() const { return config_; }
-  [[nodiscard]] const Ddpg& ddpg() const { return ddpg_; }
+  [[nodiscard]] const Algorithm& learner() const { return *learner_; }
   [[nodiscard]] double epsilon() const { return epsilon_; }
   [[nodiscard]] bool explores() const { return explore_; }
   [[nodiscard]] std::string actor() const {
@@ -566,7 +567,7 @@ class PyPolicy {
   app::ExperimentConfig config_;
   std::unique_ptr<Env> env_;  // the env the checkpoint was trained on: its sizes and action space
   EnvFacts facts_;
-  Ddpg ddpg_;
+  std::unique_ptr<Algorithm> learner_;
   bool explore_;
   ActorCopy copy_ = ActorCopy::kOnline;
   double epsilon_ = 0.0;
@@ -649,9 +650,9 @@ PYBIND11_MODULE(_pamdp, m) {
       .def("__call__", &PyPolicy::call, py::arg("observations"))
       .def_property_readonly("env_id", [](const PyPolicy& p) { return id_of(p.config().env); })
       .def_property_readonly("config_toml", [](const PyPolicy& p) { return pamdp::app::to_toml(p.config()); })
-      .def_property_readonly("updates", [](const PyPolicy& p) { return p.ddpg().updates(); })
+      .def_property_readonly("updates", [](const PyPolicy& p) { return p.learner().updates(); })
       .def_property_readonly("epsilon", &PyPolicy::epsilon)
       .def_property_readonly("exploration", &PyPolicy::explores)
       .def_property_readonly("actor", &PyPolicy::actor)
-      .def_property_readonly("observation_size", [](const PyPolicy& p) { return p.ddpg().obs_dim(); });
+      .def_property_readonly("observation_size", [](const PyPolicy& p) { return p.learner().obs_dim(); });
 }

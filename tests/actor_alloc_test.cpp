@@ -52,7 +52,9 @@ TEST(ActorLoopAllocations, SteadyStateActingAllocatesNothing) {
   ActorRunner actor(ctx, learner.join_endpoint(), config, 2, 2000, on_tick);
   const Bytes weights = [] {
     flatbuffers::FlatBufferBuilder fbb;
-    wire::build_policy_weights(fbb, 1, 0, kTestWidths, 0, constant_output_params({0.5F, -0.5F, 0.25F}));
+    const std::vector<float> params = constant_output_params({0.5F, -0.5F, 0.25F});
+    const NetworkView actor{"actor", kTestWidths, params};
+    wire::build_policy_weights(fbb, 1, 0, "ddpg", 0, {&actor, 1});
     return copy_bytes(wire::bytes_of(fbb));
   }();
   ASSERT_TRUE(serve_until(learner, {&shard}, [&] {

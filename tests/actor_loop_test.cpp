@@ -43,9 +43,23 @@ std::vector<std::pair<size_t, size_t>> episodes_in(const BatchCopy& rows) {
 }
 
 Bytes weights_message(uint64_t version, int64_t updates, uint8_t bound, const std::vector<float>& params,
-                      std::span<const int> widths = kTestWidths) {
+                      std::span<const int> widths = kTestWidths, std::string_view algorithm = "ddpg",
+                      std::string_view network = "actor") {
   flatbuffers::FlatBufferBuilder fbb;
-  wire::build_policy_weights(fbb, version, updates, widths, bound, params);
+  const NetworkView actor{network, widths, params};
+  wire::build_policy_weights(fbb, version, updates, algorithm, bound, {&actor, 1});
+  return copy_bytes(wire::bytes_of(fbb));
+}
+
+// PolicyWeights as learners before the algorithm seam wrote them: DDPG's actor in the message's
+// own widths and params, no algorithm, no named networks.
+Bytes older_weights_message(uint64_t version, int64_t updates, const std::vector<float>& params) {
+  flatbuffers::FlatBufferBuilder fbb;
+  const auto w = fbb.CreateVector(kTestWidths.data(), kTestWidths.size());
+  const auto p = fbb.CreateVector(params);
+  const auto weights = wire::CreatePolicyWeights(fbb, version, updates, w, 0, p);
+  wire::FinishEnvelopeBuffer(
+      fbb, wire::CreateEnvelope(fbb, wire::kSchemaVersion, wire::Payload::PolicyWeights, weights.Union()));
   return copy_bytes(wire::bytes_of(fbb));
 }
 
@@ -291,6 +305,16 @@ TEST(ActorLoop, AppliesPublishedWeightsAndActsWithThem) {
   for (uint32_t k = 0; k < kWidth; ++k) {
     EXPECT_NEAR(b.actions[k], std::tanh(out[k]), 1e-6);
   }
+
+  // A message from a learner before the algorithm seam is played as DDPG's actor, unsquashed.
+  const std::vector<float> later{-0.25F, 0.75F, 0.5F};
+  learner.publish(older_weights_message(3, 300, constant_output_params(later)));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.weights_version.load() == 3; }));
+  const auto older_from = static_cast<uint64_t>(actor.counters.batches_sent.load()) + 2;
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return shard.batches.size() >= older_from + 2; }));
+  for (uint32_t k = 0; k < kWidth; ++k) {
+    EXPECT_EQ(shard.batches.back().actions[k], later[k]);
+  }
 }
 
 TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
@@ -305,8 +329,8 @@ TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
   const int64_t before = actor.counters.malformed_messages.load();
   EXPECT_EQ(before, 0);
 
-  // On the weights socket: five bad messages, then good weights. One PUB connection is FIFO, so
-  // once version 2 is applied all five have been looked at.
+  // On the weights socket: seven bad messages, then good weights. One PUB connection is FIFO, so
+  // once version 2 is applied all seven have been looked at.
   std::vector<float> nan_params = good;
   nan_params[3] = std::numeric_limits<float>::quiet_NaN();
   const std::array<int, 3> wrong_obs{5, 4, 3};
@@ -319,9 +343,11 @@ TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
   learner.publish(weights_message(9, 0, 0, std::vector<float>(3 * 4 + 4 + 4 * 3 + 3), wrong_obs));
   learner.publish(weights_message(9, 0, 0, std::vector<float>(7, 0.0F)));  // wrong parameter count
   learner.publish(weights_message(9, 0, 0, nan_params));
+  learner.publish(weights_message(9, 0, 0, good, kTestWidths, "no-such-learner"));  // no acting policy for it
+  learner.publish(weights_message(9, 0, 0, good, kTestWidths, "ddpg", "critic"));   // not the network DDPG plays
   learner.publish(weights_message(2, 0, 0, good));
   ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.weights_version.load() == 2; }));
-  EXPECT_EQ(actor.counters.malformed_messages.load(), before + 5);
+  EXPECT_EQ(actor.counters.malformed_messages.load(), before + 7);
 
   // On the join socket: garbage and a message type an actor never receives; on the shard's
   // socket: anything at all.
@@ -329,7 +355,7 @@ TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
   wire::build_sample_request(fbb, 1, 32);
   learner.send_to_actor(wire::bytes_of(fbb));
   shard.send_to_actor(garbage);
-  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.malformed_messages.load() == before + 8; }));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return actor.counters.malformed_messages.load() == before + 10; }));
 
   const int64_t steps = actor.counters.env_steps.load();
   const size_t batches = shard.batches.size();

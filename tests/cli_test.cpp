@@ -21,6 +21,7 @@
 #include "envs/hfo/settings.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/ddpg_algorithm.hpp"
 
 namespace {
 
@@ -212,14 +213,15 @@ TEST(Cli, EvalPlaysTheActorAverageByDefaultWhenTheRunKeptOne) {
   pamdp::app::ExperimentConfig c = pamdp::app::parse_experiment_config(pamdp::read_checkpoint_config(model), model, {});
   c.ddpg.actor_average_tau = 1e-5;
   pamdp::hfo::HfoEnv env(pamdp::hfo::sim_config(c.env.params));
-  pamdp::Ddpg ddpg(env.observation_size(), env.action_space(), c.ddpg, 1);
-  pamdp::CheckpointMeta meta = pamdp::load_checkpoint(model, ddpg);
+  pamdp::DdpgAlgorithm learner(env.observation_size(), env.action_space(), c.ddpg, 1, pamdp::UpdateDevice::kCpu);
+  pamdp::Ddpg& ddpg = learner.ddpg();
+  pamdp::CheckpointMeta meta = pamdp::load_checkpoint(model, learner);
   const auto target = ddpg.target_actor().params();
   std::copy(target.begin(), target.end(), ddpg.actor_average().params().begin());
   meta.config_toml = pamdp::app::to_toml(c);
   const std::string averaged =
       (std::filesystem::temp_directory_path() / ("pamdp_cli_average_" + std::to_string(::getpid()) + ".ckpt")).string();
-  pamdp::save_checkpoint(averaged, ddpg, meta);
+  pamdp::save_checkpoint(averaged, learner, meta);
 
   const std::string eval = "eval --episodes 20 --json --checkpoint ";
   const RunResult plain = run_pamdp(eval + averaged, Capture::kStdoutOnly);

@@ -17,6 +17,7 @@
 #include "core/transport.hpp"
 #include "core/wire.hpp"
 #include "envs/toy/reach_stop.hpp"
+#include "learner/ddpg_algorithm.hpp"
 #include "learner/learner_server.hpp"
 
 namespace pamdp {
@@ -54,18 +55,17 @@ DdpgConfig cloning() {
 struct Running {
   net::Context ctx;
   toy::ReachStopEnv env;
-  Ddpg ddpg;
-  CpuUpdateBackend backend{ddpg};
+  DdpgAlgorithm ddpg;
   std::unique_ptr<LearnerServer> server;
   std::thread thread;
   std::atomic<bool> done{false};
   explicit Running(bool clone_demos = false, std::function<void(const UpdateStats&)> on_update = {})
-      : ddpg(kObs, env.action_space(), clone_demos ? cloning() : small(), 1) {
+      : ddpg(kObs, env.action_space(), clone_demos ? cloning() : small(), 1, UpdateDevice::kCpu) {
     LearnerServerConfig c = loopback_config();
     c.publish_every_updates = 5;
     c.max_updates = 20;
     c.clone_demos = clone_demos;
-    server = std::make_unique<LearnerServer>(ctx, backend, c);
+    server = std::make_unique<LearnerServer>(ctx, ddpg, c);
     server->on_update = std::move(on_update);
     thread = std::thread([this] {
       server->run();  // returns by itself after max_updates
@@ -186,7 +186,12 @@ TEST(LearnerServer, JoinsShardsDropsGarbageAndUpdatesFromReplies) {
   ASSERT_NE(env, nullptr);
   const wire::PolicyWeights* w = env->payload_as_PolicyWeights();
   ASSERT_NE(w, nullptr);
-  EXPECT_EQ(w->params()->size(), static_cast<uint32_t>(run.ddpg.actor().num_params()));
+  ASSERT_NE(w->algorithm(), nullptr);
+  EXPECT_EQ(w->algorithm()->str(), "ddpg");
+  ASSERT_NE(w->networks(), nullptr);
+  ASSERT_EQ(w->networks()->size(), 1U);
+  EXPECT_EQ(w->networks()->Get(0)->name()->str(), "actor");
+  EXPECT_EQ(w->networks()->Get(0)->params()->size(), static_cast<uint32_t>(run.ddpg.ddpg().actor().num_params()));
   EXPECT_GE(run.server->counters().weights_version, 2);
   // junk, wrong type, truncated, wrong-width reply.
   EXPECT_EQ(run.server->counters().malformed_messages, 4);
@@ -258,9 +263,8 @@ const wire::Envelope* await_payload(net::Socket& s, net::Message& m, wire::Paylo
 TEST(LearnerServer, EveryRandomFrameAtTheJoinSocketIsCounted) {
   net::Context ctx;
   toy::ReachStopEnv env;
-  Ddpg ddpg{kObs, env.action_space(), small(), 1};
-  CpuUpdateBackend backend{ddpg};
-  LearnerServer server(ctx, backend, loopback_config());
+  DdpgAlgorithm ddpg{kObs, env.action_space(), small(), 1, UpdateDevice::kCpu};
+  LearnerServer server(ctx, ddpg, loopback_config());
   std::thread thread([&] { server.run(); });
   net::Socket probe(ctx, net::SocketType::kDealer);
   probe.connect(server.join_endpoint());
@@ -298,9 +302,8 @@ TEST(LearnerServer, EveryRandomFrameAtTheJoinSocketIsCounted) {
 TEST(LearnerServer, EpisodeReportsOnlyFromJoinedActors) {
   net::Context ctx;
   toy::ReachStopEnv env;
-  Ddpg ddpg{kObs, env.action_space(), small(), 1};
-  CpuUpdateBackend backend{ddpg};
-  LearnerServer server(ctx, backend, loopback_config());
+  DdpgAlgorithm ddpg{kObs, env.action_space(), small(), 1, UpdateDevice::kCpu};
+  LearnerServer server(ctx, ddpg, loopback_config());
   std::atomic<int> reported{0};
   server.on_episode = [&](const EpisodeSummary&) { reported.fetch_add(1); };
   std::thread thread([&] { server.run(); });
@@ -340,11 +343,10 @@ TEST(LearnerServer, EpisodeReportsOnlyFromJoinedActors) {
 TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   net::Context ctx;
   toy::ReachStopEnv env;
-  Ddpg ddpg{kObs, env.action_space(), small(), 1};
-  CpuUpdateBackend backend{ddpg};
+  DdpgAlgorithm ddpg{kObs, env.action_space(), small(), 1, UpdateDevice::kCpu};
   LearnerServerConfig c = loopback_config();
   c.metrics_url = "http://learner:1/metrics";
-  LearnerServer server(ctx, backend, c);
+  LearnerServer server(ctx, ddpg, c);
   std::mutex mutex;
   std::vector<std::string> written;
   int writes = 0;
@@ -407,14 +409,13 @@ TEST(LearnerServer, CurveRefusesForeignKeysAtJoinAndWeights) {
   net::Context ctx;
   net::CurveAuthenticator auth(ctx, {cluster_client.public_key});  // before the sockets
   toy::ReachStopEnv env;
-  Ddpg ddpg{kObs, env.action_space(), small(), 1};
-  CpuUpdateBackend backend{ddpg};
+  DdpgAlgorithm ddpg{kObs, env.action_space(), small(), 1, UpdateDevice::kCpu};
   LearnerServerConfig c = loopback_config();
   c.publish_every_updates = 2;
   c.max_updates = 400;
   c.curve = server_keys;
   c.curve_client = good;
-  LearnerServer server(ctx, backend, c);
+  LearnerServer server(ctx, ddpg, c);
   std::atomic<bool> done{false};
   std::thread thread([&] {
     server.run();

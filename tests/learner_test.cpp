@@ -24,6 +24,7 @@
 #include "envs/toy/reach_stop.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/ddpg_algorithm.hpp"
 #include "learner/gradient_bounds.hpp"
 #include "learner/update_backend.hpp"
 #include "replay/episode_buffer.hpp"
@@ -590,8 +591,9 @@ TEST(Train, SolvesReachStop) {
 
 std::vector<float> params_of(const std::string& ckpt, const app::ExperimentConfig& c) {
   toy::ReachStopEnv env;
-  Ddpg d(3, env.action_space(), c.ddpg, 99);
-  load_checkpoint(ckpt, d);
+  DdpgAlgorithm d_alg(3, env.action_space(), c.ddpg, 99, UpdateDevice::kCpu);
+  Ddpg& d = d_alg.ddpg();
+  load_checkpoint(ckpt, d_alg);
   std::vector<float> all(d.actor().params().begin(), d.actor().params().end());
   all.insert(all.end(), d.critic().params().begin(), d.critic().params().end());
   all.insert(all.end(), d.target_critic().params().begin(), d.target_critic().params().end());
@@ -849,33 +851,35 @@ TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
   fs::create_directories(dir);
   const std::string path = (dir / "c.ckpt").string();
   toy::ReachStopEnv env;
-  Ddpg d(3, env.action_space(), tiny_config(), 1);
-  save_checkpoint(path, d, {});
-  EXPECT_NO_THROW(load_checkpoint(path, d));
+  DdpgAlgorithm d_alg(3, env.action_space(), tiny_config(), 1, UpdateDevice::kCpu);
+  Ddpg& d = d_alg.ddpg();
+  save_checkpoint(path, d_alg, {});
+  EXPECT_NO_THROW(load_checkpoint(path, d_alg));
   EXPECT_FALSE(fs::exists(path + ".tmp"));
 
   std::vector<uint8_t> bytes = read_file_bytes(path);
   const std::vector<uint8_t> good = bytes;
   bytes.resize(bytes.size() / 2);
   write_file_atomically(path, bytes.data(), bytes.size());
-  EXPECT_THROW(load_checkpoint(path, d), std::runtime_error);
+  EXPECT_THROW(load_checkpoint(path, d_alg), std::runtime_error);
 
   bytes = good;
   bytes[4] = 'X';  // file identifier
   write_file_atomically(path, bytes.data(), bytes.size());
-  EXPECT_THROW(load_checkpoint(path, d), std::runtime_error);
+  EXPECT_THROW(load_checkpoint(path, d_alg), std::runtime_error);
 
   write_file_atomically(path, good.data(), good.size());
   DdpgConfig wider = tiny_config();
   wider.hidden = {9};
-  Ddpg other(3, env.action_space(), wider, 1);
+  DdpgAlgorithm other_alg(3, env.action_space(), wider, 1, UpdateDevice::kCpu);
+  Ddpg& other = other_alg.ddpg();
   try {
-    load_checkpoint(path, other);
+    load_checkpoint(path, other_alg);
     FAIL() << "mismatched checkpoint accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("widths"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(load_checkpoint((dir / "missing.ckpt").string(), d), std::runtime_error);
+  EXPECT_THROW(load_checkpoint((dir / "missing.ckpt").string(), d_alg), std::runtime_error);
   fs::remove_all(dir);
 }
 
@@ -889,14 +893,16 @@ TEST(Checkpoint, WarmStartWidensTheInputsExactly) {
   const std::string path = (dir / "w.ckpt").string();
   toy::ReachStopEnv env;
   const ActionSpace& space = env.action_space();
-  Ddpg from(3, space, tiny_config(), 1);
+  DdpgAlgorithm from_alg(3, space, tiny_config(), 1, UpdateDevice::kCpu);
+  Ddpg& from = from_alg.ddpg();
   Rng rng(5);
   for (Mlp<float>* net : {&from.actor(), &from.critic(), &from.target_actor(), &from.target_critic()}) {
     net->init_gaussian(rng, 0.5F);  // targets differ from the online networks
   }
-  save_checkpoint(path, from, {});
-  Ddpg to(5, space, tiny_config(), 2);
-  warm_start_from_checkpoint(path, to);
+  save_checkpoint(path, from_alg, {});
+  DdpgAlgorithm to_alg(5, space, tiny_config(), 2, UpdateDevice::kCpu);
+  Ddpg& to = to_alg.ddpg();
+  warm_start_from_checkpoint(path, to_alg);
 
   const int act = from.output_width();
   Eigen::MatrixXf wide = Eigen::MatrixXf::Random(5 + act, 4);
@@ -921,9 +927,9 @@ TEST(Checkpoint, WarmStartWidensTheInputsExactly) {
   // Other hidden widths, or fewer observations than the checkpoint's, are refused with the reason.
   DdpgConfig wider = tiny_config();
   wider.hidden = {9};
-  Ddpg other(5, space, wider, 1);
-  Ddpg fewer(2, space, tiny_config(), 1);
-  for (Ddpg* d : {&other, &fewer}) {
+  DdpgAlgorithm other_alg(5, space, wider, 1, UpdateDevice::kCpu);
+  DdpgAlgorithm fewer_alg(2, space, tiny_config(), 1, UpdateDevice::kCpu);
+  for (DdpgAlgorithm* d : {&other_alg, &fewer_alg}) {
     try {
       warm_start_from_checkpoint(path, *d);
       FAIL() << "a warm start into other shapes was accepted";
@@ -943,31 +949,35 @@ TEST(Checkpoint, ActorAverageRoundTrips) {
   toy::ReachStopEnv env;
   DdpgConfig c = tiny_config();
   c.actor_average_tau = 0.01;
-  Ddpg from(3, env.action_space(), c, 1);
+  DdpgAlgorithm from_alg(3, env.action_space(), c, 1, UpdateDevice::kCpu);
+  Ddpg& from = from_alg.ddpg();
   Rng rng(7);
   from.actor_average().init_gaussian(rng, 0.5F);
   from.set_updates(9);
   from.set_actor_average_updates(7);
-  save_checkpoint(path, from, {});
-  Ddpg back(3, env.action_space(), c, 2);
-  load_checkpoint(path, back);
+  save_checkpoint(path, from_alg, {});
+  DdpgAlgorithm back_alg(3, env.action_space(), c, 2, UpdateDevice::kCpu);
+  Ddpg& back = back_alg.ddpg();
+  load_checkpoint(path, back_alg);
   EXPECT_TRUE(std::equal(from.actor_average().params().begin(), from.actor_average().params().end(),
                          back.actor_average().params().begin()));
   EXPECT_EQ(back.actor_average_updates(), 7);
   EXPECT_EQ(back.updates(), 9);
 
   DdpgConfig off = tiny_config();
-  Ddpg plain(3, env.action_space(), off, 3);
+  DdpgAlgorithm plain_alg(3, env.action_space(), off, 3, UpdateDevice::kCpu);
+  Ddpg& plain = plain_alg.ddpg();
   plain.set_updates(5);
-  save_checkpoint(path, plain, {});
-  load_checkpoint(path, back);
+  save_checkpoint(path, plain_alg, {});
+  load_checkpoint(path, back_alg);
   EXPECT_TRUE(
       std::equal(plain.actor().params().begin(), plain.actor().params().end(), back.actor_average().params().begin()));
   EXPECT_EQ(back.actor_average_updates(), 5);
 
-  save_checkpoint(path, from, {});
-  Ddpg warm(3, env.action_space(), c, 4);
-  warm_start_from_checkpoint(path, warm);
+  save_checkpoint(path, from_alg, {});
+  DdpgAlgorithm warm_alg(3, env.action_space(), c, 4, UpdateDevice::kCpu);
+  Ddpg& warm = warm_alg.ddpg();
+  warm_start_from_checkpoint(path, warm_alg);
   EXPECT_TRUE(
       std::equal(from.actor().params().begin(), from.actor().params().end(), warm.actor_average().params().begin()));
   EXPECT_EQ(warm.actor_average_updates(), 0);
@@ -989,8 +999,9 @@ TEST(Train, ActorAverageSurvivesAResume) {
   app::train(config(3000), {b.string(), true, true, nullptr});
   const auto average_of = [](const fs::path& ckpt, const app::ExperimentConfig& c) {
     toy::ReachStopEnv env;
-    Ddpg d(3, env.action_space(), c.ddpg, 99);
-    load_checkpoint(ckpt.string(), d);
+    DdpgAlgorithm d_alg(3, env.action_space(), c.ddpg, 99, UpdateDevice::kCpu);
+    Ddpg& d = d_alg.ddpg();
+    load_checkpoint(ckpt.string(), d_alg);
     EXPECT_EQ(d.actor_average_updates(), d.updates());
     return std::vector<float>(d.actor_average().params().begin(), d.actor_average().params().end());
   };
@@ -1115,7 +1126,8 @@ TEST(UpdateBackend, CudaWithoutADeviceIsAClearError) {
   }
   EXPECT_FALSE(why.empty());
   toy::ReachStopEnv env;
-  Ddpg d(3, env.action_space(), tiny_config(), 5);
+  DdpgAlgorithm d_alg(3, env.action_space(), tiny_config(), 5, UpdateDevice::kCpu);
+  Ddpg& d = d_alg.ddpg();
   try {
     make_update_backend(d, UpdateDevice::kCuda);
     FAIL() << "ddpg.device = cuda accepted without a device";

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "envs/toy/reach_stop.hpp"
+#include "learner/ddpg_algorithm.hpp"
 #include "replay/replay_buffer.hpp"
 
 namespace pamdp {
@@ -52,20 +53,19 @@ RunSpec spec_in(const fs::path& dir, bool keeps) {
 struct Learner {
   toy::ReachStopEnv env;
   toy::ReachStopEnv eval_env;
-  Ddpg ddpg{env.observation_size(), env.action_space(), tiny_config(), 5};
-  CpuUpdateBackend backend{ddpg};
+  DdpgAlgorithm ddpg{env.observation_size(), env.action_space(), tiny_config(), 5, UpdateDevice::kCpu};
   BatchBuffers batch{env.observation_size(), env.action_space().output_width(), 4};
 
   void update(TrainingRun& run, int n) {
     const int obs = env.observation_size();
     const int width = env.action_space().output_width();
     for (int i = 0; i < n; ++i) {
-      run.record_update(backend.update({Eigen::Map<const Eigen::MatrixXf>(batch.states.data(), obs, 4),
-                                        Eigen::Map<const Eigen::MatrixXf>(batch.actions.data(), width, 4),
-                                        Eigen::Map<const Eigen::VectorXf>(batch.rewards.data(), 4),
-                                        Eigen::Map<const Eigen::MatrixXf>(batch.next_states.data(), obs, 4),
-                                        Eigen::Map<const Eigen::VectorXf>(batch.terminal.data(), 4),
-                                        Eigen::Map<const Eigen::VectorXf>(batch.mc_returns.data(), 4)}));
+      run.record_update(ddpg.update({Eigen::Map<const Eigen::MatrixXf>(batch.states.data(), obs, 4),
+                                     Eigen::Map<const Eigen::MatrixXf>(batch.actions.data(), width, 4),
+                                     Eigen::Map<const Eigen::VectorXf>(batch.rewards.data(), 4),
+                                     Eigen::Map<const Eigen::MatrixXf>(batch.next_states.data(), obs, 4),
+                                     Eigen::Map<const Eigen::VectorXf>(batch.terminal.data(), 4),
+                                     Eigen::Map<const Eigen::VectorXf>(batch.mc_returns.data(), 4)}));
     }
   }
 };
@@ -82,7 +82,7 @@ size_t lines_in(const fs::path& file) {
 TEST(TrainingRun, CountsEpisodesAndWritesRowsWithTheRatesByHand) {
   const fs::path dir = fresh_dir("rows");
   Learner l;
-  TrainingRun run(spec_in(dir, false), l.ddpg, l.backend, l.env, l.eval_env);
+  TrainingRun run(spec_in(dir, false), l.ddpg, l.env, l.eval_env);
   run.start(false);
   EXPECT_TRUE(fs::exists(dir / "config.toml"));
   run.record_env_steps(3);
@@ -114,7 +114,7 @@ TEST(TrainingRun, CountsEpisodesAndWritesRowsWithTheRatesByHand) {
 TEST(TrainingRun, EvaluatesEveryNUpdatesAndKeepsTheBest) {
   const fs::path dir = fresh_dir("eval");
   Learner l;
-  TrainingRun run(spec_in(dir, false), l.ddpg, l.backend, l.env, l.eval_env);
+  TrainingRun run(spec_in(dir, false), l.ddpg, l.env, l.eval_env);
   int evals = 0;
   run.on_eval = [&](const EvalResult& r) {
     ++evals;
@@ -141,7 +141,7 @@ TEST(TrainingRun, EvaluatesEveryNUpdatesAndKeepsTheBest) {
 
 // Writes a run with a checkpoint after two episodes and a third episode after it.
 void run_past_a_checkpoint(const fs::path& dir, Learner& l) {
-  TrainingRun run(spec_in(dir, false), l.ddpg, l.backend, l.env, l.eval_env);
+  TrainingRun run(spec_in(dir, false), l.ddpg, l.env, l.eval_env);
   int saves = 0;
   run.before_checkpoint = [&] { ++saves; };
   run.on_save = [](CheckpointMeta& m) { m.weights_version = 42; };
@@ -163,7 +163,7 @@ TEST(TrainingRun, AReplayingResumeDropsTheEpisodesAfterItsCheckpoint) {
   Learner l;
   run_past_a_checkpoint(dir, l);
   Learner again;
-  TrainingRun resumed(spec_in(dir, false), again.ddpg, again.backend, again.env, again.eval_env);
+  TrainingRun resumed(spec_in(dir, false), again.ddpg, again.env, again.eval_env);
   const CheckpointMeta meta = resumed.start(true);
   EXPECT_EQ(meta.weights_version, 42);
   EXPECT_EQ(resumed.updates(), 3);
@@ -181,7 +181,7 @@ TEST(TrainingRun, AKeepingResumeCountsTheEpisodesAfterItsCheckpoint) {
   Learner l;
   run_past_a_checkpoint(dir, l);
   Learner again;
-  TrainingRun resumed(spec_in(dir, true), again.ddpg, again.backend, again.env, again.eval_env);
+  TrainingRun resumed(spec_in(dir, true), again.ddpg, again.env, again.eval_env);
   resumed.start(true);
   EXPECT_EQ(resumed.episodes(), 3);
   EXPECT_EQ(resumed.env_steps(), 14);
@@ -203,7 +203,7 @@ TEST(TrainingRun, AKeepingResumeCountsTheEpisodesAfterItsCheckpoint) {
 TEST(TrainingRun, AResumeWithoutACheckpointNamesTheFile) {
   const fs::path dir = fresh_dir("none");
   Learner l;
-  TrainingRun run(spec_in(dir, false), l.ddpg, l.backend, l.env, l.eval_env);
+  TrainingRun run(spec_in(dir, false), l.ddpg, l.env, l.eval_env);
   try {
     run.start(true);
     FAIL() << "resumed without a checkpoint";

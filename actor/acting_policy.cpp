@@ -1,0 +1,42 @@
+#include "actor/acting_policy.hpp"
+
+#include <stdexcept>
+
+namespace pamdp {
+
+void register_ddpg_acting_policy(ActingPolicyRegistry& registry);  // actor/ddpg_acting_policy.cpp
+
+void ActingPolicyRegistry::add(ActingPolicyRegistration registration) {
+  if (find(registration.name) != nullptr) {
+    throw std::logic_error("acting policy '" + registration.name + "' is registered twice");
+  }
+  registrations_.push_back(std::move(registration));
+}
+
+const ActingPolicyRegistration* ActingPolicyRegistry::find(std::string_view name) const {
+  for (const ActingPolicyRegistration& r : registrations_) {
+    if (r.name == name) {
+      return &r;
+    }
+  }
+  return nullptr;
+}
+
+std::string ActingPolicyRegistry::names() const {
+  std::string s;
+  for (const ActingPolicyRegistration& r : registrations_) {
+    s += (s.empty() ? "" : ", ") + r.name;
+  }
+  return s;
+}
+
+const ActingPolicyRegistry& acting_policy_registry() {
+  static const ActingPolicyRegistry kRegistry = [] {
+    ActingPolicyRegistry r;
+    register_ddpg_acting_policy(r);  // one line per algorithm
+    return r;
+  }();
+  return kRegistry;
+}
+
+}  // namespace pamdp
