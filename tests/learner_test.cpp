@@ -852,7 +852,6 @@ TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
   const std::string path = (dir / "c.ckpt").string();
   toy::ReachStopEnv env;
   DdpgAlgorithm d_alg(3, env.action_space(), tiny_config(), 1, UpdateDevice::kCpu);
-  Ddpg& d = d_alg.ddpg();
   save_checkpoint(path, d_alg, {});
   EXPECT_NO_THROW(load_checkpoint(path, d_alg));
   EXPECT_FALSE(fs::exists(path + ".tmp"));
@@ -872,7 +871,6 @@ TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
   DdpgConfig wider = tiny_config();
   wider.hidden = {9};
   DdpgAlgorithm other_alg(3, env.action_space(), wider, 1, UpdateDevice::kCpu);
-  Ddpg& other = other_alg.ddpg();
   try {
     load_checkpoint(path, other_alg);
     FAIL() << "mismatched checkpoint accepted";
