@@ -43,6 +43,15 @@ inline std::string env_help_footer() {
   return out;
 }
 
+// The registered learners, for the --help of the commands that train.
+inline std::string algorithm_help_footer() {
+  std::string out = "Learners (train.algorithm):";
+  for (const AlgorithmRegistration& r : algorithm_registry().all()) {
+    out += "\n  " + r.name + std::string(r.name.size() < 12 ? 12 - r.name.size() : 1, ' ') + r.description;
+  }
+  return out;
+}
+
 // Resolves action names ("TACKLE") and parameter ranges by name against the env's space.
 inline ExplorationConfig resolve_exploration(const ExperimentConfig& c, const ActionSpace& space) {
   ExplorationConfig e = c.exploration;

@@ -210,12 +210,12 @@ void register_learner(CLI::App& app) {
   auto o = std::make_shared<LearnerCliOptions>();
   CLI::App* cmd = app.add_subcommand("learner",
                                      "the learner of the distributed system: samples replay shards, "
-                                     "runs DDPG updates, broadcasts weights");
+                                     "runs the learner's updates (train.algorithm), broadcasts weights");
   add_run_options(*cmd, *o,
                   {"TOML config (default: the paper preset)",
                    "override one config key, e.g. --set cluster.learner_bind=tcp://127.0.0.1:6000",
                    "where config, metrics and checkpoints go"});
-  cmd->footer(env_help_footer());
+  cmd->footer(env_help_footer() + "\n\n" + algorithm_help_footer());
   cmd->callback([o] { run_learner(*o); });
 }
 

@@ -94,14 +94,16 @@ void run_train(const TrainCliOptions& o) {
 
 void register_train(CLI::App& app) {
   auto o = std::make_shared<TrainCliOptions>();
-  CLI::App* cmd = app.add_subcommand("train", "train DDPG in one process (env, replay and learner in one thread)");
+  CLI::App* cmd = app.add_subcommand(
+      "train",
+      "train a learner (train.algorithm, DDPG by default) in one process (env, replay and learner in one thread)");
   add_run_options(*cmd, *o,
                   {"TOML config (presets: deploy/configs/paper.toml, fast.toml, reach_stop.toml); default: built-in "
                    "paper settings",
                    "override one config key, e.g. --set ddpg.gamma=0.95 (repeatable)",
                    "where config, metrics and checkpoints go (default runs/<time>-seed<S>)"});
   cmd->add_flag("--json", o->json, "print one JSON summary object as the last line");
-  cmd->footer(env_help_footer());
+  cmd->footer(env_help_footer() + "\n\n" + algorithm_help_footer());
   cmd->callback([o] { run_train(*o); });
 }
 
