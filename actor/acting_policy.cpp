@@ -4,7 +4,8 @@
 
 namespace pamdp {
 
-void register_ddpg_acting_policy(ActingPolicyRegistry& registry);  // actor/ddpg_acting_policy.cpp
+void register_ddpg_acting_policy(ActingPolicyRegistry& registry);    // actor/ddpg_acting_policy.cpp
+void register_pdqn_acting_policies(ActingPolicyRegistry& registry);  // actor/pdqn_acting_policy.cpp
 
 void ActingPolicyRegistry::add(ActingPolicyRegistration registration) {
   if (find(registration.name) != nullptr) {
@@ -34,6 +35,7 @@ const ActingPolicyRegistry& acting_policy_registry() {
   static const ActingPolicyRegistry kRegistry = [] {
     ActingPolicyRegistry r;
     register_ddpg_acting_policy(r);  // one line per algorithm
+    register_pdqn_acting_policies(r);
     return r;
   }();
   return kRegistry;

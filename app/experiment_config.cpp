@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/env_factory.hpp"
 #include "envs/hfo/settings.hpp"
 
 namespace pamdp::app {
@@ -562,6 +563,7 @@ std::unique_ptr<Algorithm> make_learner(const ExperimentConfig& config, int obs_
   args.ddpg = &config.ddpg;
   args.seed = seed;
   args.device = device.value_or(config.ddpg.device);
+  args.masked_actions = resolve_exploration(config, space).masked_actions;
   return make_algorithm(config.train.algorithm, args);
 }
 

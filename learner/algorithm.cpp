@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "learner/ddpg_algorithm.hpp"
+#include "learner/pdqn.hpp"
 
 namespace pamdp {
 
@@ -34,6 +35,7 @@ const AlgorithmRegistry& algorithm_registry() {
   static const AlgorithmRegistry kRegistry = [] {
     AlgorithmRegistry r;
     register_ddpg_algorithm(r);  // one line per algorithm
+    register_pdqn_algorithms(r);
     return r;
   }();
   return kRegistry;

@@ -150,6 +150,9 @@ struct AlgorithmArgs {
   uint64_t seed = 0;
   // Where updates run; kCpu for a learner that only acts (pamdp eval, the Python bindings).
   UpdateDevice device = UpdateDevice::kAuto;
+  // Actions never taken (exploration.masked_actions, resolved): a value-based learner leaves them
+  // out of its max.
+  std::vector<int> masked_actions;
 };
 
 struct AlgorithmRegistration {

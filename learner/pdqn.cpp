@@ -1,0 +1,342 @@
+#include "learner/pdqn.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "learner/gradient_bounds.hpp"
+
+namespace pamdp {
+namespace {
+
+std::vector<int> widths(int in, const std::vector<int>& hidden, int out) {
+  std::vector<int> w{in};
+  w.insert(w.end(), hidden.begin(), hidden.end());
+  w.push_back(out);
+  return w;
+}
+
+AdamConfig adam(const DdpgConfig& c, double lr) {
+  return {lr, c.adam_beta1, c.adam_beta2, c.adam_epsilon};
+}
+
+const DdpgConfig& checked(const DdpgConfig& c, bool multipass) {
+  const std::string name = multipass ? "mpdqn" : "pdqn";
+  if (c.batch_size < 1) {
+    throw std::invalid_argument("ddpg.batch_size must be >= 1");
+  }
+  if (c.demo_bc_weight > 0.0) {
+    throw std::invalid_argument("ddpg.demo_bc_weight: " + name +
+                                " does not clone demonstrations; set it to 0 (or train.algorithm = \"ddpg\")");
+  }
+  if (c.actor_average_tau > 0.0) {
+    throw std::invalid_argument("ddpg.actor_average_tau: " + name +
+                                " keeps no evaluation average; set it to 0 (or train.algorithm = \"ddpg\")");
+  }
+  if (c.device == UpdateDevice::kCuda) {
+    throw std::invalid_argument("ddpg.device = cuda: " + name +
+                                " updates on the CPU only; set ddpg.device = \"cpu\" or \"auto\"");
+  }
+  return c;
+}
+
+}  // namespace
+
+Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, bool multipass,
+           std::vector<int> masked_actions)
+    : obs_dim_(obs_dim),
+      num_actions_(space.num_actions()),
+      num_params_(space.num_params()),
+      multipass_(multipass),
+      config_(checked(config, multipass)),
+      param_bounds_(parameter_bounds(space)),
+      masked_(static_cast<size_t>(space.num_actions()), false),
+      owner_(static_cast<size_t>(space.num_params()), 0),
+      param_(widths(obs_dim, config.hidden, space.num_params()), config.batch_size),
+      q_(widths(obs_dim + space.num_params(), config.hidden, space.num_actions()),
+         (multipass ? space.num_actions() : 1) * config.batch_size),
+      target_param_(param_.widths(), config.batch_size),
+      target_q_(q_.widths(), (multipass ? space.num_actions() : 1) * config.batch_size),
+      param_adam_(param_.num_params(), adam(config, config.actor_learning_rate)),
+      q_adam_(q_.num_params(), adam(config, config.critic_learning_rate)),
+      forward_(obs_dim, space, multipass),
+      x_(space.num_params(), config.batch_size),
+      q_in_(obs_dim + space.num_params(), (multipass ? space.num_actions() : 1) * config.batch_size),
+      d_q_(space.num_actions(), (multipass ? space.num_actions() : 1) * config.batch_size),
+      d_x_(space.num_params(), config.batch_size),
+      y_(config.batch_size),
+      taken_(static_cast<size_t>(config.batch_size), 0) {
+  if (space.num_params() < 1) {
+    throw std::invalid_argument("P-DQN needs an action space with continuous parameters");
+  }
+  for (const int k : masked_actions) {
+    if (k >= 0 && k < num_actions_) {
+      masked_[static_cast<size_t>(k)] = true;
+    }
+  }
+  if (std::all_of(masked_.begin(), masked_.end(), [](bool m) { return m; })) {
+    throw std::invalid_argument("every action is masked: unmask at least one (exploration.masked_actions)");
+  }
+  for (int k = 0; k < num_actions_; ++k) {
+    owned_.push_back(space.actions[static_cast<size_t>(k)].param_indices);
+    for (const int p : owned_.back()) {
+      owner_[static_cast<size_t>(p)] = k;
+    }
+  }
+  Rng rng(seed);
+  const auto s = static_cast<float>(config.init_std);
+  param_.init_gaussian(rng, s);
+  q_.init_gaussian(rng, s, static_cast<float>(config.critic_output_init_std),
+                   static_cast<float>(config.critic_output_init_bias));
+  std::copy(param_.params().begin(), param_.params().end(), target_param_.params().begin());
+  std::copy(q_.params().begin(), q_.params().end(), target_q_.params().begin());
+}
+
+void Pdqn::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
+  const bool target = copy == ActorCopy::kTarget;
+  forward_(target ? target_param_ : param_, target ? target_q_ : q_,
+           config_.bound == BoundMethod::kSquashing ? &param_bounds_ : nullptr, obs, out);
+}
+
+ActingWeights Pdqn::acting_weights() {
+  return {name(),
+          static_cast<uint8_t>(config_.bound),
+          {{"param", param_.widths(), param_.params()}, {"q", q_.widths(), q_.params()}}};
+}
+
+void Pdqn::parameters_of(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int B) {
+  const auto raw = net.forward(states.leftCols(B));
+  if (config_.bound == BoundMethod::kSquashing) {
+    for (int j = 0; j < B; ++j) {
+      squash({raw.col(j).data(), static_cast<size_t>(num_params_)}, param_bounds_,
+             {x_.col(j).data(), static_cast<size_t>(num_params_)});
+    }
+  } else {
+    x_.leftCols(B) = raw;
+  }
+}
+
+int Pdqn::fill_q_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
+                       int B) {
+  if (!multipass_) {
+    q_in_.topLeftCorner(obs_dim_, B) = states.leftCols(B);
+    q_in_.bottomLeftCorner(num_params_, B) = x.leftCols(B);
+    return B;
+  }
+  for (int k = 0; k < num_actions_; ++k) {
+    q_in_.block(0, k * B, obs_dim_, B) = states.leftCols(B);
+    q_in_.block(obs_dim_, k * B, num_params_, B).setZero();
+    for (const int p : owned_[static_cast<size_t>(k)]) {
+      q_in_.block(obs_dim_ + p, k * B, 1, B) = x.block(p, 0, 1, B);
+    }
+  }
+  return num_actions_ * B;
+}
+
+void Pdqn::fill_taken_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
+                            int B) {
+  q_in_.topLeftCorner(obs_dim_, B) = states.leftCols(B);
+  q_in_.bottomLeftCorner(num_params_, B) = x.leftCols(B);
+  if (multipass_) {
+    for (int j = 0; j < B; ++j) {
+      for (int p = 0; p < num_params_; ++p) {
+        if (owner_[static_cast<size_t>(p)] != taken_[static_cast<size_t>(j)]) {
+          q_in_(obs_dim_ + p, j) = 0.0F;
+        }
+      }
+    }
+  }
+}
+
+void Pdqn::targets(const BatchView& batch, int B) {
+  parameters_of(target_param_, batch.next_states, B);
+  const int cols = fill_q_input(batch.next_states, x_, B);
+  const auto q_next = target_q_.forward(q_in_.leftCols(cols));
+  const auto g = static_cast<float>(config_.gamma);
+  const auto beta = static_cast<float>(config_.mc_mix);
+  for (int j = 0; j < B; ++j) {
+    float best = -std::numeric_limits<float>::infinity();
+    for (int k = 0; k < num_actions_; ++k) {
+      if (!masked_[static_cast<size_t>(k)]) {
+        best = std::max(best, q_of(q_next, k, j, B));
+      }
+    }
+    float y = batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * best);
+    if (beta > 0.0F) {
+      y = beta * batch.mc_returns(j) + (1.0F - beta) * y;
+    }
+    y_(j) = y;
+  }
+  // The action each sample took: the arg-max of its stored scores over the unmasked actions.
+  for (int j = 0; j < B; ++j) {
+    int k_best = -1;
+    for (int k = 0; k < num_actions_; ++k) {
+      if (!masked_[static_cast<size_t>(k)] && (k_best < 0 || batch.actions(k, j) > batch.actions(k_best, j))) {
+        k_best = k;
+      }
+    }
+    taken_[static_cast<size_t>(j)] = k_best;
+  }
+}
+
+double Pdqn::q_step_gradient(const BatchView& batch, int B, UpdateStats& stats) {
+  fill_taken_input(batch.states, batch.actions.bottomRows(num_params_), B);
+  const auto q = q_.forward(q_in_.leftCols(B));
+  d_q_.leftCols(B).setZero();
+  double loss = 0.0;
+  for (int j = 0; j < B; ++j) {
+    const int k = taken_[static_cast<size_t>(j)];
+    const float diff = q(k, j) - y_(j);
+    loss += 0.5 * static_cast<double>(diff) * diff;
+    d_q_(k, j) = diff / static_cast<float>(B);
+    stats.q_mean += q(k, j);
+    stats.target_mean += y_(j);
+  }
+  stats.q_mean /= static_cast<float>(B);
+  stats.target_mean /= static_cast<float>(B);
+  q_.backward(d_q_.leftCols(B), false);
+  return loss / B;
+}
+
+double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& stats) {
+  parameters_of(param_, batch.states, B);
+  int at_bound = 0;
+  for (int j = 0; j < B; ++j) {
+    for (int p = 0; p < num_params_; ++p) {
+      const float v = x_(p, j);
+      at_bound +=
+          (v <= param_bounds_.lo[static_cast<size_t>(p)] || v >= param_bounds_.hi[static_cast<size_t>(p)]) ? 1 : 0;
+    }
+  }
+  stats.params_at_bound_fraction = static_cast<float>(at_bound) / static_cast<float>(num_params_ * B);
+  const int cols = fill_q_input(batch.states, x_, B);
+  const auto q = q_.forward(q_in_.leftCols(cols));
+  d_q_.leftCols(cols).setZero();
+  double loss = 0.0;
+  const float per_sample = -1.0F / static_cast<float>(B);
+  for (int j = 0; j < B; ++j) {
+    for (int k = 0; k < num_actions_; ++k) {
+      if (!masked_[static_cast<size_t>(k)]) {
+        loss -= q_of(q, k, j, B);
+        d_q_(k, multipass_ ? k * B + j : j) = per_sample;
+      }
+    }
+  }
+  q_.backward_input(d_q_.leftCols(cols));  // only dL/dx: the Q-network's parameter gradients are not needed
+  const auto in_grad = q_.input_grad();
+  for (int j = 0; j < B; ++j) {
+    for (int p = 0; p < num_params_; ++p) {
+      // In a multi-pass batch x_p reaches Q only through the pass of the action that owns it.
+      const int col = multipass_ ? owner_[static_cast<size_t>(p)] * B + j : j;
+      d_x_(p, j) = in_grad(obs_dim_ + p, col);
+    }
+  }
+  apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), param_.output(), d_x_.leftCols(B));
+  param_.backward(d_x_.leftCols(B), false);
+  return loss / B;
+}
+
+Pdqn::Losses Pdqn::gradients(const BatchView& batch) {
+  const int B = static_cast<int>(batch.states.cols());
+  UpdateStats stats;
+  Losses l;
+  targets(batch, B);
+  l.q_loss = q_step_gradient(batch, B, stats);
+  l.param_loss = param_step_gradient(batch, B, stats);
+  return l;
+}
+
+Pdqn::Losses Pdqn::losses(const BatchView& batch) {
+  const int B = static_cast<int>(batch.states.cols());
+  Losses l;
+  targets(batch, B);
+  fill_taken_input(batch.states, batch.actions.bottomRows(num_params_), B);
+  const auto q = q_.forward(q_in_.leftCols(B));
+  for (int j = 0; j < B; ++j) {
+    const float diff = q(taken_[static_cast<size_t>(j)], j) - y_(j);
+    l.q_loss += 0.5 * static_cast<double>(diff) * diff / B;
+  }
+  parameters_of(param_, batch.states, B);
+  const int cols = fill_q_input(batch.states, x_, B);
+  const auto qx = q_.forward(q_in_.leftCols(cols));
+  for (int j = 0; j < B; ++j) {
+    for (int k = 0; k < num_actions_; ++k) {
+      if (!masked_[static_cast<size_t>(k)]) {
+        l.param_loss -= static_cast<double>(q_of(qx, k, j, B)) / B;
+      }
+    }
+  }
+  return l;
+}
+
+void Pdqn::schedule_learning_rates() {
+  if (config_.lr_decay_updates <= 0) {
+    return;
+  }
+  const double done = std::min(1.0, static_cast<double>(updates_) / static_cast<double>(config_.lr_decay_updates));
+  const double scale = 1.0 - (1.0 - config_.lr_final_fraction) * done;
+  param_adam_.set_learning_rate(config_.actor_learning_rate * scale);
+  q_adam_.set_learning_rate(config_.critic_learning_rate * scale);
+}
+
+UpdateStats Pdqn::update(const BatchView& batch, const BatchView* /*demos*/) {
+  const int B = static_cast<int>(batch.states.cols());
+  assert(B <= config_.batch_size && batch.states.rows() == obs_dim_);
+  schedule_learning_rates();
+  UpdateStats stats;
+  targets(batch, B);
+  stats.critic_loss = static_cast<float>(q_step_gradient(batch, B, stats));
+  stats.critic_grad_norm = static_cast<float>(clip_global_norm(q_.grads(), config_.clip_grad_norm));
+  q_adam_.step(q_.params(), q_.grads());
+  param_step_gradient(batch, B, stats);  // through the just-updated Q-network
+  stats.actor_grad_norm = static_cast<float>(clip_global_norm(param_.grads(), config_.clip_grad_norm));
+  param_adam_.step(param_.params(), param_.grads());
+  soft_update<float>(target_param_.params(), param_.params(), config_.tau);
+  soft_update<float>(target_q_.params(), q_.params(), config_.tau);
+  ++updates_;
+  last_ = stats;
+  return stats;
+}
+
+std::vector<StateTensor> Pdqn::state_tensors() {
+  std::vector<StateTensor> t;
+  const auto net = [&](const char* n, Mlp<float>& m) { t.push_back({n, m.params(), m.widths(), false}); };
+  const auto moments = [&](const std::string& n, Adam<float>& a) {
+    t.push_back({n + ".m", a.first_moment(), {}, false});
+    t.push_back({n + ".v", a.second_moment(), {}, false});
+  };
+  net("param", param_);
+  net("q", q_);
+  net("target_param", target_param_);
+  net("target_q", target_q_);
+  moments("param_adam", param_adam_);
+  moments("q_adam", q_adam_);
+  return t;
+}
+
+std::vector<StateCounter> Pdqn::state_counters() {
+  counters_ = {updates_, param_adam_.steps(), q_adam_.steps()};
+  return {{"updates", &counters_[0]}, {"param_adam.steps", &counters_[1]}, {"q_adam.steps", &counters_[2]}};
+}
+
+void Pdqn::restored(const std::vector<std::string>& /*missing*/) {
+  updates_ = counters_[0];
+  param_adam_.set_steps(counters_[1]);
+  q_adam_.set_steps(counters_[2]);
+}
+
+void register_pdqn_algorithms(AlgorithmRegistry& registry) {
+  for (const bool multipass : {false, true}) {
+    registry.add({multipass ? "mpdqn" : "pdqn",
+                  multipass ? "MP-DQN: P-DQN with one Q pass per action (Bester, James & Konidaris 2019)"
+                            : "P-DQN: a Q-network over all parameters and a parameter network (Xiong et al. 2018)",
+                  [multipass](const AlgorithmArgs& a) {
+                    return std::make_unique<Pdqn>(a.obs_dim, *a.space, *a.ddpg, a.seed, multipass, a.masked_actions);
+                  }});
+  }
+}
+
+}  // namespace pamdp

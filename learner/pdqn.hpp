@@ -1,0 +1,135 @@
+// P-DQN (Xiong et al. 2018, "Parametrized Deep Q-Networks Learning: Reinforcement Learning with
+// Discrete-Continuous Hybrid Action Space") and MP-DQN (Bester, James & Konidaris 2019,
+// "Multi-Pass Q-Networks for Deep Reinforcement Learning with Parameterised Action Spaces")
+// behind the algorithm seam (learner/algorithm.hpp), registered as "pdqn" and "mpdqn".
+//
+// Networks: a parameter network x(s; θ) giving every action's parameters, and a Q-network
+// Q(s, x; ω) giving one value per discrete action, each with a soft-updated target copy.
+// MP-DQN differs only in how Q reads x: pass k sees action k's parameters alone
+// (core/pdqn_output.hpp).
+//
+// One update on a batch of B transitions (s, a, r, s'), a = (scores, parameters) as stored, the
+// taken action k the arg-max of the stored scores over the unmasked actions:
+//   1. y = r + γ max_k' Q'(s', k', x'(s')) (0 after a terminal), the max over unmasked actions,
+//      mixed with the Monte-Carlo return as DDPG does (ddpg.mc_mix);
+//   2. Q step on (1 / 2B) Σ (Q(s, k, x_a) - y)², x_a the stored parameters (for MP-DQN, only
+//      action k's, the others zero);
+//   3. parameter step on L = -(1 / B) Σ_batch Σ_k Q(s, k, x(s)) over the unmasked k, through the
+//      updated Q-network (its parameter gradients discarded), the gradient on x kept in bounds by
+//      ddpg.bound (inverting by default, as cycraig/MP-DQN; squashing squashes x);
+//   4. soft target updates at rate ddpg.tau.
+// It reads the ddpg.* settings (hidden widths for both networks, learning rates: actor for the
+// parameter network, critic for the Q-network, Adam, γ, τ, batch, clipping, bound, Monte-Carlo
+// mix, learning-rate decay, initialisation). It neither clones demonstrations nor keeps an
+// evaluation average, and runs on the CPU: a config that asks for those is refused.
+//
+// State names: networks "param", "q", "target_param", "target_q"; Adam moments "param_adam.m",
+// "param_adam.v", "q_adam.m", "q_adam.v"; counters "updates", "param_adam.steps",
+// "q_adam.steps". The actors get "param" and "q". update() allocates nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/mlp.hpp"
+#include "core/optim.hpp"
+#include "core/pdqn_output.hpp"
+#include "learner/algorithm.hpp"
+#include "learner/ddpg.hpp"
+
+namespace pamdp {
+
+class Pdqn final : public Algorithm {
+ public:
+  // `masked_actions` are never taken (HFO's Tackle): left out of the max and of the parameter loss.
+  Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, bool multipass,
+       std::vector<int> masked_actions = {});
+
+  [[nodiscard]] std::string_view name() const override { return multipass_ ? "mpdqn" : "pdqn"; }
+  [[nodiscard]] int obs_dim() const override { return obs_dim_; }
+  [[nodiscard]] int output_width() const override { return num_actions_ + num_params_; }
+  [[nodiscard]] int batch_size() const override { return config_.batch_size; }
+  [[nodiscard]] int64_t updates() const override { return updates_; }
+  [[nodiscard]] const char* device() const override { return "cpu"; }
+
+  UpdateStats update(const BatchView& batch, const BatchView* demos = nullptr) override;
+  UpdateStats finish() override { return last_; }
+
+  void sync_acting() override {}
+  void act(std::span<const float> obs, std::span<float> out, ActorCopy copy = ActorCopy::kOnline) override;
+  ActingWeights acting_weights() override;
+
+  void sync_to_host() override {}
+  std::vector<StateTensor> state_tensors() override;
+  std::vector<StateCounter> state_counters() override;
+  void restored(const std::vector<std::string>& missing) override;
+  void warm_started() override {}
+
+  // The gradients of one update's two losses at the current weights, left in q_net().grads() and
+  // param_net().grads() (the parameter loss through the current Q-network), with the losses'
+  // values; nothing is stepped. For gradient checks; update() computes the same on the way.
+  struct Losses {
+    double q_loss = 0.0;
+    double param_loss = 0.0;
+  };
+  Losses gradients(const BatchView& batch);
+  // The two losses alone (no gradients), for finite differences.
+  Losses losses(const BatchView& batch);
+
+  Mlp<float>& param_net() { return param_; }
+  Mlp<float>& q_net() { return q_; }
+  Mlp<float>& target_param_net() { return target_param_; }
+  Mlp<float>& target_q_net() { return target_q_; }
+
+ private:
+  // x(s) for the batch's states into x_ (and the raw outputs in the network).
+  void parameters_of(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int B);
+  // Q-network inputs for B states and the parameters in `x` (P x B): one pass, or K passes
+  // (pass k in columns k*B .. k*B + B - 1 holds only action k's parameters). Returns the columns.
+  int fill_q_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x, int B);
+  // The same for each sample's own action `taken_`: one column per sample.
+  void fill_taken_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
+                        int B);
+  // Q(s, k, ·) of sample j from a forward over fill_q_input's columns.
+  [[nodiscard]] float q_of(const Mlp<float>::ConstBlock& q, int k, int j, int B) const {
+    return multipass_ ? q(k, k * B + j) : q(k, j);
+  }
+  void targets(const BatchView& batch, int B);
+  double q_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
+  double param_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
+  void schedule_learning_rates();
+
+  int obs_dim_;
+  int num_actions_;
+  int num_params_;
+  bool multipass_;
+  DdpgConfig config_;
+  OutputBounds param_bounds_;
+  std::vector<bool> masked_;
+  std::vector<int> owner_;  // per parameter: the action that owns it
+  std::vector<std::vector<int>> owned_;
+  Mlp<float> param_;
+  Mlp<float> q_;
+  Mlp<float> target_param_;
+  Mlp<float> target_q_;
+  Adam<float> param_adam_;
+  Adam<float> q_adam_;
+  int64_t updates_ = 0;
+  UpdateStats last_;
+  PdqnForward forward_;
+  std::array<int64_t, 3> counters_{};
+
+  // Scratch, sized in the constructor for batch_size.
+  Eigen::MatrixXf x_;       // P x B: parameters fed to the Q-network
+  Eigen::MatrixXf q_in_;    // (obs + P) x (K * B)
+  Eigen::MatrixXf d_q_;     // K x (K * B)
+  Eigen::MatrixXf d_x_;     // P x B
+  Eigen::VectorXf y_;       // B
+  std::vector<int> taken_;  // B
+};
+
+void register_pdqn_algorithms(AlgorithmRegistry& registry);
+
+}  // namespace pamdp

@@ -1,0 +1,299 @@
+// P-DQN and MP-DQN (learner/pdqn.hpp): finite-difference checks of both losses' gradients,
+// hand-computed losses (the taken action, the masked max, MP-DQN's one-action passes), the
+// actors' acting policy against the learner's own act(), and the toy task learned end to end
+// through `pamdp train`, resumed bit for bit.
+#include "learner/pdqn.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "actor/acting_policy.hpp"
+#include "app/experiment_config.hpp"
+#include "app/trainer.hpp"
+#include "envs/toy/reach_stop.hpp"
+#include "learner/checkpoint.hpp"
+
+namespace pamdp {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Three actions: one with one parameter, one with two, one with none.
+ActionSpace test_space() {
+  ActionSpace s;
+  s.actions = {{"one", {0}}, {"two", {1, 2}}, {"none", {}}};
+  s.params = {{"p0", -1.0F, 1.0F}, {"p1", -2.0F, 2.0F}, {"p2", 0.0F, 1.0F}};
+  return s;
+}
+
+constexpr int kObs = 3;
+constexpr int kB = 5;
+
+DdpgConfig small(BoundMethod bound) {
+  DdpgConfig c;
+  c.hidden = {6};
+  c.batch_size = kB;
+  c.bound = bound;
+  c.gamma = 0.9;
+  c.init_std = 0.5;
+  c.critic_output_init_std = 0.5;
+  c.critic_output_init_bias = 0.0;
+  c.device = UpdateDevice::kCpu;
+  return c;
+}
+
+struct Batch {
+  Eigen::MatrixXf states = Eigen::MatrixXf::Random(kObs, kB);
+  Eigen::MatrixXf actions = Eigen::MatrixXf::Random(6, kB);  // 3 scores, 3 parameters in (-1, 1)
+  Eigen::VectorXf rewards = Eigen::VectorXf::Random(kB);
+  Eigen::MatrixXf next_states = Eigen::MatrixXf::Random(kObs, kB);
+  Eigen::VectorXf terminal = Eigen::VectorXf::Zero(kB);
+  Eigen::VectorXf mc = Eigen::VectorXf::Zero(kB);
+  Batch() {
+    terminal(1) = 1.0F;
+    actions.row(5) = actions.row(5).cwiseAbs();  // p2 in [0, 1]
+  }
+  [[nodiscard]] BatchView view() const {
+    return {Eigen::Map<const Eigen::MatrixXf>(states.data(), kObs, kB),
+            Eigen::Map<const Eigen::MatrixXf>(actions.data(), 6, kB),
+            Eigen::Map<const Eigen::VectorXf>(rewards.data(), kB),
+            Eigen::Map<const Eigen::MatrixXf>(next_states.data(), kObs, kB),
+            Eigen::Map<const Eigen::VectorXf>(terminal.data(), kB),
+            Eigen::Map<const Eigen::VectorXf>(mc.data(), kB)};
+  }
+};
+
+// Central differences of `loss` in every parameter of `net` against the gradient left in
+// net.grads(). Float arithmetic and leaky-ReLU kinks: a coordinate agrees within 3e-3 + 3% of the
+// gradient; all but at most one in twenty must.
+void expect_gradients(Mlp<float>& net, const std::function<double()>& loss, const char* what) {
+  const std::vector<float> grads(net.grads().begin(), net.grads().end());
+  const float h = 1e-3F;
+  int bad = 0;
+  double largest = 0.0;
+  for (size_t i = 0; i < grads.size(); ++i) {
+    const float keep = net.params()[i];
+    net.params()[i] = keep + h;
+    const double up = loss();
+    net.params()[i] = keep - h;
+    const double down = loss();
+    net.params()[i] = keep;
+    const double fd = (up - down) / (2.0 * h);
+    largest = std::max(largest, std::abs(fd));
+    if (std::abs(fd - grads[i]) > 3e-3 + 0.03 * std::abs(fd)) {
+      ++bad;
+    }
+  }
+  EXPECT_LE(bad, static_cast<int>(grads.size()) / 20) << what << ": " << bad << " of " << grads.size() << " disagree";
+  EXPECT_GT(largest, 1e-2) << what << ": the loss does not depend on these parameters";
+}
+
+class PdqnGradients : public ::testing::TestWithParam<std::tuple<bool, BoundMethod>> {};
+
+TEST_P(PdqnGradients, MatchFiniteDifferences) {
+  const auto [multipass, bound] = GetParam();
+  ActionSpace space = test_space();
+  for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
+    p.lo = -10.0F;
+    p.hi = 10.0F;
+  }
+  Pdqn pdqn(kObs, space, small(bound), 3, multipass, /*masked_actions=*/{2});
+  // Targets unlike the online networks, so the target term is not the online one.
+  Rng rng(11);
+  pdqn.target_q_net().init_gaussian(rng, 0.5F);
+  pdqn.target_param_net().init_gaussian(rng, 0.5F);
+  const Batch b;
+  const BatchView v = b.view();
+  pdqn.gradients(v);
+  expect_gradients(
+      pdqn.q_net(), [&] { return pdqn.losses(v).q_loss; }, "Q loss");
+  // The parameter loss's gradient is only the loss's own where the bound leaves it alone: zeroing
+  // inside the bounds, or squashing (the chain rule through tanh).
+  pdqn.gradients(v);
+  expect_gradients(
+      pdqn.param_net(), [&] { return pdqn.losses(v).param_loss; }, "parameter loss");
+}
+
+INSTANTIATE_TEST_SUITE_P(Pdqn, PdqnGradients,
+                         ::testing::Combine(::testing::Bool(),
+                                            ::testing::Values(BoundMethod::kZeroing, BoundMethod::kSquashing)));
+
+// Both losses by hand from the networks' own forward passes: the taken action is the arg-max of
+// the stored scores over the unmasked actions (a masked action's high score is passed over), the
+// target's max skips the masked action, MP-DQN's Q sees only the taken action's parameters, and
+// the parameter loss sums Q over the unmasked actions.
+TEST(Pdqn, LossesByHand) {
+  for (const bool multipass : {false, true}) {
+    const ActionSpace space = test_space();
+    Pdqn pdqn(kObs, space, small(BoundMethod::kInverting), 5, multipass, /*masked_actions=*/{1});
+    Batch b;
+    b.actions.col(0) << 0.2F, 0.9F, 0.1F, 0.5F, -0.5F, 0.25F;  // "two" scores highest but is masked
+    const BatchView v = b.view();
+    double q_loss = 0.0;
+    double param_loss = 0.0;
+    std::vector<float> out(6);
+    std::vector<float> next(6);
+    for (int j = 0; j < kB; ++j) {
+      int taken = -1;
+      for (const int k : {0, 2}) {
+        taken = taken < 0 || b.actions(k, j) > b.actions(taken, j) ? k : taken;
+      }
+      if (j == 0) {
+        ASSERT_EQ(taken, 0);
+      }
+      Eigen::MatrixXf in(kObs + 3, 1);
+      in.col(0).head(kObs) = b.states.col(j);
+      in.col(0).tail(3) = b.actions.col(j).tail(3);
+      if (multipass) {
+        for (int p = 0; p < 3; ++p) {
+          const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
+          if (std::find(owned.begin(), owned.end(), p) == owned.end()) {
+            in(kObs + p, 0) = 0.0F;
+          }
+        }
+      }
+      const float q = pdqn.q_net().forward(in)(taken, 0);
+      pdqn.act({b.next_states.col(j).data(), kObs}, next, ActorCopy::kTarget);
+      const float best = std::max(next[0], next[2]);
+      const float y = b.rewards(j) + (b.terminal(j) > 0.5F ? 0.0F : 0.9F * best);
+      q_loss += 0.5 * (q - y) * (q - y) / kB;
+      pdqn.act({b.states.col(j).data(), kObs}, out, ActorCopy::kOnline);
+      param_loss -= (out[0] + out[2]) / kB;
+    }
+    const Pdqn::Losses l = pdqn.losses(v);
+    EXPECT_NEAR(l.q_loss, q_loss, 1e-5 * (1.0 + q_loss)) << (multipass ? "mpdqn" : "pdqn");
+    EXPECT_NEAR(l.param_loss, param_loss, 1e-5 * (1.0 + std::abs(param_loss))) << (multipass ? "mpdqn" : "pdqn");
+  }
+}
+
+// MP-DQN's score k comes from a pass that sees only action k's parameters, all K passes of
+// x(s): rebuilt by hand here from act()'s own parameters.
+TEST(Pdqn, MultiPassScoresComeFromOnePassPerAction) {
+  const ActionSpace space = test_space();
+  Pdqn mp(kObs, space, small(BoundMethod::kInverting), 5, true);
+  const Eigen::Vector3f s(0.1F, -0.3F, 0.7F);
+  std::vector<float> a(6);
+  mp.act({s.data(), kObs}, a);
+  Eigen::MatrixXf passes(kObs + 3, 3);
+  for (int k = 0; k < 3; ++k) {
+    passes.col(k) << s, Eigen::Vector3f::Zero();
+  }
+  passes(kObs + 0, 0) = a[3];  // "one" owns p0
+  passes(kObs + 1, 1) = a[4];  // "two" owns p1 and p2
+  passes(kObs + 2, 1) = a[5];  // "none" owns nothing
+  const Eigen::MatrixXf q = mp.q_net().forward(passes);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_FLOAT_EQ(a[static_cast<size_t>(k)], q(k, k)) << "action " << k;
+  }
+  // A pass that saw the other actions' parameters too would give other values.
+  passes.col(0).tail(3) << a[3], a[4], a[5];
+  EXPECT_NE(mp.q_net().forward(passes)(0, 0), a[0]);
+}
+
+// What an actor plays from the published networks is exactly what the learner's act() gives.
+TEST(Pdqn, TheActorsPlayWhatTheLearnerActs) {
+  for (const bool multipass : {false, true}) {
+    for (const BoundMethod bound : {BoundMethod::kInverting, BoundMethod::kSquashing}) {
+      const ActionSpace space = test_space();
+      Pdqn pdqn(kObs, space, small(bound), 9, multipass);
+      const ActingWeights w = pdqn.acting_weights();
+      const ActingPolicyRegistration* r = acting_policy_registry().find(w.algorithm);
+      ASSERT_NE(r, nullptr) << w.algorithm;
+      const std::unique_ptr<ActingPolicy> policy = r->make(kObs, space);
+      ASSERT_EQ(policy->check(w.networks, w.bound), nullptr);
+      policy->load(w.networks, w.bound);
+      std::vector<float> mine(6);
+      std::vector<float> theirs(6);
+      for (int i = 0; i < 20; ++i) {
+        const Eigen::Vector3f s = Eigen::Vector3f::Random();
+        pdqn.act({s.data(), kObs}, mine);
+        policy->act({s.data(), kObs}, theirs);
+        EXPECT_EQ(mine, theirs) << w.algorithm;
+      }
+      // The other algorithm's networks are refused.
+      const ActingWeights ddpg_like{"ddpg", 0, {w.networks[0]}};
+      EXPECT_NE(policy->check(ddpg_like.networks, 0), nullptr);
+    }
+  }
+}
+
+app::ExperimentConfig toy(const std::string& algorithm, int64_t updates) {
+  std::ifstream in(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/reach_stop.toml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  app::ExperimentConfig c = app::parse_experiment_config(ss.str(), "reach_stop.toml", {});
+  c.train.algorithm = algorithm;
+  c.train.max_updates = updates;
+  c.train.log_every_seconds = 1e9;
+  return c;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("pamdp_pdqn_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+std::vector<float> state_of(const fs::path& ckpt, const app::ExperimentConfig& c) {
+  const toy::ReachStopEnv env;
+  const std::unique_ptr<Algorithm> a = app::make_learner(c, env.observation_size(), env.action_space(), 99);
+  load_checkpoint(ckpt.string(), *a);
+  std::vector<float> all;
+  for (const StateTensor& t : a->state_tensors()) {
+    all.insert(all.end(), t.values.begin(), t.values.end());
+  }
+  all.push_back(static_cast<float>(a->updates()));
+  return all;
+}
+
+// The toy task, learned in about a second by each, through `pamdp train`'s own loop; a run
+// stopped and resumed ends where one that never stopped does.
+TEST(Pdqn, LearnsReachStopAndResumesExactly) {
+  for (const std::string algorithm : {"pdqn", "mpdqn"}) {
+    const fs::path dir = fresh_dir(algorithm);
+    const app::TrainSummary s = app::train(toy(algorithm, 12000), {dir.string(), false, true, nullptr});
+    EXPECT_GE(s.final_eval.goal_rate, 0.9) << algorithm << " failed to learn ReachStop";
+    EXPECT_EQ(read_checkpoint_algorithm((dir / "checkpoint.ckpt").string()), algorithm);
+
+    const fs::path straight = fresh_dir(algorithm + "_straight");
+    const fs::path halves = fresh_dir(algorithm + "_halves");
+    app::train(toy(algorithm, 3000), {straight.string(), false, true, nullptr});
+    app::train(toy(algorithm, 1950), {halves.string(), false, true, nullptr});
+    app::train(toy(algorithm, 3000), {halves.string(), true, true, nullptr});
+    EXPECT_EQ(state_of(straight / "checkpoint.ckpt", toy(algorithm, 3000)),
+              state_of(halves / "checkpoint.ckpt", toy(algorithm, 3000)))
+        << algorithm;
+    for (const fs::path& d : {dir, straight, halves}) {
+      fs::remove_all(d);
+    }
+  }
+}
+
+// Settings P-DQN does not have are refused naming the key, not ignored.
+TEST(Pdqn, RefusesSettingsItDoesNotHave) {
+  const ActionSpace space = test_space();
+  DdpgConfig cloning = small(BoundMethod::kInverting);
+  cloning.demo_bc_weight = 1.0;
+  DdpgConfig average = small(BoundMethod::kInverting);
+  average.actor_average_tau = 1e-3;
+  DdpgConfig gpu = small(BoundMethod::kInverting);
+  gpu.device = UpdateDevice::kCuda;
+  for (const auto& [config, key] : {std::pair{cloning, "ddpg.demo_bc_weight"},
+                                    std::pair{average, "ddpg.actor_average_tau"}, std::pair{gpu, "ddpg.device"}}) {
+    try {
+      Pdqn p(kObs, space, config, 1, false);
+      ADD_FAILURE() << key << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pamdp
