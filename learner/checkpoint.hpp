@@ -33,13 +33,15 @@ void save_checkpoint(const std::string& path, Algorithm& algorithm, const Checkp
 // Restores `algorithm` (which must be the file's and have been built with the same shapes) and
 // returns the metadata.
 CheckpointMeta load_checkpoint(const std::string& path, Algorithm& algorithm);
-// Warm start (train.init_from): the networks of another run's checkpoint -- actor, critic and both
-// targets -- for a run whose observations extend that run's: the same first features, possibly
-// more after them (1v0's 58 continued in 1v1's 66, where the goalie's 8 follow). Hidden and action
-// widths must match. The extra inputs start with zero weights, so the warm-started networks
-// compute what the checkpoint's did (up to float summation order), whatever the extra features hold. Optimizer state,
-// counters and random streams stay this run's own. Refused with the reason if the shapes differ.
-// Applies to the algorithm's networks (state tensors with widths, optional ones aside).
+// Warm start (train.init_from): the networks of another run's checkpoint of the same algorithm
+// (its state tensors with widths, optional ones aside: for DDPG actor, critic and both targets)
+// for a run whose observations extend that run's: the same first features, possibly more after
+// them (1v0's 58 continued in 1v1's 66, where the goalie's 8 follow). Every network reads the
+// state first, so the extra inputs go after the first `obs` inputs of its first layer. Hidden and
+// action widths must match. The extra inputs start with zero weights, so the warm-started
+// networks compute what the checkpoint's did (up to float summation order), whatever the extra
+// features hold. Optimizer state, counters and random streams stay this run's own. Refused with
+// the reason if the shapes differ.
 void warm_start_from_checkpoint(const std::string& path, Algorithm& algorithm);
 // Reads only the config stored in a checkpoint (to rebuild the learner before loading).
 std::string read_checkpoint_config(const std::string& path);

@@ -651,6 +651,7 @@ PYBIND11_MODULE(_pamdp, m) {
       .def_property_readonly("env_id", [](const PyPolicy& p) { return id_of(p.config().env); })
       .def_property_readonly("config_toml", [](const PyPolicy& p) { return pamdp::app::to_toml(p.config()); })
       .def_property_readonly("updates", [](const PyPolicy& p) { return p.learner().updates(); })
+      .def_property_readonly("algorithm", [](const PyPolicy& p) { return std::string(p.learner().name()); })
       .def_property_readonly("epsilon", &PyPolicy::epsilon)
       .def_property_readonly("exploration", &PyPolicy::explores)
       .def_property_readonly("actor", &PyPolicy::actor)

@@ -182,7 +182,7 @@ class VectorEnv(_pamdp.VectorEnv):
 
 
 class Policy(_pamdp.Policy):
-    """A checkpoint's actor: policy(obs) for one observation (obs_size,) returns one action
+    """A checkpoint's actor (of any learner, `algorithm`: "ddpg", "pdqn", "mpdqn"): policy(obs) for one observation (obs_size,) returns one action
     (id, params); for a batch (B, obs_size) it returns (ids (B,), params), the vector env's
     action format. Greedy by default: the action `pamdp eval` plays (the actor copy its run
     evaluated, masked actions never chosen, parameters as the actor outputs them; the env clamps
@@ -195,7 +195,7 @@ class Policy(_pamdp.Policy):
         return make(self.env_id, **{k: table[k] for k in _pamdp.option_names(self.env_id)})
 
     def __repr__(self):
-        return f"pamdp.Policy(env '{self.env_id}', {self.updates} updates, actor {self.actor})"
+        return f"pamdp.Policy({self.algorithm}, env '{self.env_id}', {self.updates} updates, actor {self.actor})"
 
 
 def make(env_id: str = "hfo-1v0", **options) -> Env:

@@ -44,16 +44,20 @@ class CheckpointFromPython(unittest.TestCase):
                 self.check_against_pamdp_eval(os.path.join(SOURCE, path), episodes, seed, floor)
 
     def test_toy_task_checkpoint(self):
-        # A fresh reach_stop run (under a second) and its checkpoint, read back from Python.
-        with tempfile.TemporaryDirectory() as run:
-            subprocess.run([PAMDP, "train", "--config", os.path.join(SOURCE, "deploy/configs/reach_stop.toml"),
-                            "--run-dir", run, "--seed", "3"], check=True, capture_output=True)
-            path = os.path.join(run, "checkpoint.ckpt")
-            self.check_against_pamdp_eval(path, 200, 5, 0.5)
-            policy = pamdp.load_policy(path)
-            self.assertEqual(policy.env_id, "reach_stop")
-            ids, params = policy(np.zeros((3, 3), np.float32))
-            self.assertEqual([p.shape for p in params], [(3, 1), (3, 0)])
+        # A fresh reach_stop run (under a second) of each learner and its checkpoint, read back
+        # from Python.
+        for algorithm in ("ddpg", "mpdqn"):
+            with self.subTest(algorithm=algorithm), tempfile.TemporaryDirectory() as run:
+                subprocess.run([PAMDP, "train", "--config", os.path.join(SOURCE, "deploy/configs/reach_stop.toml"),
+                                "--run-dir", run, "--seed", "3", "--set", "train.algorithm=" + algorithm],
+                               check=True, capture_output=True)
+                path = os.path.join(run, "checkpoint.ckpt")
+                self.check_against_pamdp_eval(path, 200, 5, 0.5)
+                policy = pamdp.load_policy(path)
+                self.assertEqual(policy.env_id, "reach_stop")
+                self.assertEqual(policy.algorithm, algorithm)
+                ids, params = policy(np.zeros((3, 3), np.float32))
+                self.assertEqual([p.shape for p in params], [(3, 1), (3, 0)])
 
     def test_batch_and_exploration(self):
         full = os.path.join(SOURCE, CASES[0][0])
