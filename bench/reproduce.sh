@@ -2,15 +2,18 @@
 # Reruns one full training and evaluation end to end and prints the paper-style table row, so
 # anyone can check a results claim on their own machine:
 #
-#   bench/reproduce.sh [--config FILE] [--seed S] [--run-dir DIR] [--episodes N] [--set key=value ...]
+#   bench/reproduce.sh [--config FILE] [--seed S] [--run-dir DIR] [--episodes N]
+#                      [--checkpoint best|final] [--set key=value ...]
 #
 # Trains with `pamdp train` (default deploy/configs/fast.toml, seed 1, run directory
 # runs/reproduce-<config>-seed<S>; an existing one is resumed), evaluates the best greedy
-# checkpoint (best.ckpt, else checkpoint.ckpt) on N episodes (default 100, the paper's protocol)
-# with `pamdp eval --seed 1`, and prints:
+# checkpoint (best.ckpt, else checkpoint.ckpt; --checkpoint final: the final policy,
+# checkpoint.ckpt, MP-DQN's protocol) on N episodes (default 100, the paper's protocol) with
+# `pamdp eval --seed 1`, and prints:
 #
 #   config, seed, updates, episodes, wall-clock, first update/hour at which the goal rate over
-#   the last 100 training episodes reached .90 and .96, scoring rate, average steps to goal.
+#   the last 100 training episodes reached .90 and .96, scoring rate, average steps to goal,
+#   mean return (Platform's measure).
 #
 # Builds build/bin/pamdp first if it is missing (PAMDP_BIN=path/to/pamdp runs another build).
 set -euo pipefail
@@ -21,9 +24,10 @@ config=deploy/configs/fast.toml
 seed=1
 run_dir=""
 episodes=100
+which=best
 sets=()
 
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "reproduce: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -33,6 +37,7 @@ while [[ $# -gt 0 ]]; do
     --seed) need_value "$@"; seed=$2; shift 2 ;;
     --run-dir) need_value "$@"; run_dir=$2; shift 2 ;;
     --episodes) need_value "$@"; episodes=$2; shift 2 ;;
+    --checkpoint) need_value "$@"; which=$2; shift 2 ;;
     --set) need_value "$@"; sets+=(--set "$2"); shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) die "unknown argument '$1' (see --help)" ;;
@@ -41,6 +46,7 @@ done
 [[ -f $config ]] || die "no config file '$config' (presets are in deploy/configs/)"
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
 [[ $episodes =~ ^[1-9][0-9]*$ ]] || die "--episodes must be a positive integer, not '$episodes'"
+[[ $which == best || $which == final ]] || die "--checkpoint takes best or final, not '$which'"
 
 bin=${PAMDP_BIN:-build/bin/pamdp}
 if [[ ! -x $bin ]]; then
@@ -58,8 +64,8 @@ else
   "$bin" train --config "$config" --seed "$seed" --run-dir "$run_dir" "${sets[@]}"
 fi
 
-checkpoint=$run_dir/best.ckpt
-[[ -f $checkpoint ]] || checkpoint=$run_dir/checkpoint.ckpt
+checkpoint=$run_dir/checkpoint.ckpt
+[[ $which == best && -f $run_dir/best.ckpt ]] && checkpoint=$run_dir/best.ckpt
 result=$("$bin" eval --checkpoint "$checkpoint" --episodes "$episodes" --seed 1 --json | tail -n 1)
 
 # The first metrics row at which the training goal rate (last 100 episodes) reached a level.
@@ -79,8 +85,9 @@ last_row() {
 read -r updates train_episodes hours <<<"$(last_row)"
 json_field() { sed -E "s/.*\"$1\":([^,}]*).*/\1/" <<<"$result"; }
 
-printf '\n| config | seed | updates | episodes | wall-clock (h) | .90 reached (updates / h) | .96 reached | scoring (%s ep) | avg steps to goal |\n' "$episodes"
-printf '| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n'
-printf '| %s | %s | %s | %s | %s | %s | %s | %.3f | %.1f |\n' "$name" "$seed" "$updates" "$train_episodes" "$hours" \
-  "$(first_reach 0.90)" "$(first_reach 0.96)" "$(json_field goal_rate)" "$(json_field avg_steps_to_goal)"
+printf '\n| config | seed | updates | episodes | wall-clock (h) | .90 reached (updates / h) | .96 reached | scoring (%s ep, %s) | avg steps to goal | mean return |\n' "$episodes" "$which"
+printf '| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n'
+printf '| %s | %s | %s | %s | %s | %s | %s | %.3f | %.1f | %.3f |\n' "$name" "$seed" "$updates" "$train_episodes" "$hours" \
+  "$(first_reach 0.90)" "$(first_reach 0.96)" "$(json_field goal_rate)" "$(json_field avg_steps_to_goal)" \
+  "$(json_field avg_return)"
 echo "$result"

@@ -3,10 +3,13 @@
 # and prints one table row per seed plus a verdict against a scoring / steps target:
 #
 #   bench/seeds.sh [--config FILE] [--seeds 1,2,3,4,5] [--jobs 2] [--episodes N]
-#                  [--target-rate R] [--target-steps S] [--out DIR] [--set key=value ...]
+#                  [--checkpoint best|final] [--target-rate R] [--target-steps S] [--out DIR]
+#                  [--set key=value ...]
 #
 # Defaults: deploy/configs/fast.toml, seeds 1-5, 2 at a time (one per core), evaluation on 1,000
-# episodes, target: scoring >= .99 with <= 80 average steps to goal (issue 7). Run directories
+# episodes of best.ckpt (--checkpoint final: of the final policy, MP-DQN's protocol, as for the
+# presets deploy/configs/<task>-<learner>.toml), target: scoring >= .99 with <= 80 average steps
+# to goal (issue 7); the mean scoring and mean return over the seeds follow the rows. Run directories
 # are DIR/seedS (default DIR runs/seeds-<config>; an existing one is resumed) with each seed's
 # log beside it. Exit status 0 whether or not the target is met; 2 on a usage error, 1 when a
 # seed's training or evaluation failed (its log says why).
@@ -18,12 +21,13 @@ config=deploy/configs/fast.toml
 seeds=1,2,3,4,5
 jobs=2
 episodes=1000
+which=best
 target_rate=0.99
 target_steps=80
 out=""
 sets=()
 
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "seeds: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -33,6 +37,7 @@ while [[ $# -gt 0 ]]; do
     --seeds) need_value "$@"; seeds=$2; shift 2 ;;
     --jobs) need_value "$@"; jobs=$2; shift 2 ;;
     --episodes) need_value "$@"; episodes=$2; shift 2 ;;
+    --checkpoint) need_value "$@"; which=$2; shift 2 ;;
     --target-rate) need_value "$@"; target_rate=$2; shift 2 ;;
     --target-steps) need_value "$@"; target_steps=$2; shift 2 ;;
     --out) need_value "$@"; out=$2; shift 2 ;;
@@ -45,6 +50,7 @@ done
 [[ $seeds =~ ^[0-9]+(,[0-9]+)*$ ]] || die "--seeds takes a comma-separated list of integers, e.g. 1,2,3, not '$seeds'"
 [[ $jobs =~ ^[1-9][0-9]*$ ]] || die "--jobs must be a positive integer, not '$jobs'"
 [[ $episodes =~ ^[1-9][0-9]*$ ]] || die "--episodes must be a positive integer, not '$episodes'"
+[[ $which == best || $which == final ]] || die "--checkpoint takes best or final, not '$which'"
 [[ $target_rate =~ ^(0(\.[0-9]+)?|1(\.0+)?)$ ]] || die "--target-rate must be in [0, 1], not '$target_rate'"
 [[ $target_steps =~ ^[0-9]+(\.[0-9]+)?$ ]] || die "--target-steps must be a non-negative number, not '$target_steps'"
 
@@ -60,7 +66,7 @@ for seed in "${seed_list[@]}"; do
   done
   echo "seeds: training seed $seed (log $out/seed$seed.log)" >&2
   bash bench/reproduce.sh --config "$config" --seed "$seed" --run-dir "$out/seed$seed" --episodes "$episodes" \
-    "${sets[@]}" >"$out/seed$seed.log" 2>&1 &
+    --checkpoint "$which" "${sets[@]}" >"$out/seed$seed.log" 2>&1 &
   pids+=($!)
 done
 failed=0
@@ -82,6 +88,8 @@ for seed in "${seed_list[@]}"; do
 done
 met=0
 ran=0
+sum_rate=0
+sum_return=0
 for seed in "${seed_list[@]}"; do
   log=$out/seed$seed.log
   row=$(grep -E "^\| $name \| $seed \|" "$log" | tail -n 1 || true)
@@ -94,10 +102,17 @@ for seed in "${seed_list[@]}"; do
   ran=$((ran + 1))
   rate=$(sed -E 's/.*"goal_rate":([^,}]*).*/\1/' <<<"$json")
   steps=$(sed -E 's/.*"avg_steps_to_goal":([^,}]*).*/\1/' <<<"$json")
+  ret=$(sed -E 's/.*"avg_return":([^,}]*).*/\1/' <<<"$json")
+  sum_rate=$(awk -v a="$sum_rate" -v b="$rate" 'BEGIN { print a + b }')
+  sum_return=$(awk -v a="$sum_return" -v b="$ret" 'BEGIN { print a + b }')
   if awk -v r="$rate" -v s="$steps" -v tr="$target_rate" -v ts="$target_steps" 'BEGIN { exit !(r >= tr && s <= ts) }'; then
     met=$((met + 1))
   fi
 done
+if ((ran > 0)); then
+  awk -v r="$sum_rate" -v g="$sum_return" -v n="$ran" -v w="$which" \
+    'BEGIN { printf "\nmean over %d seeds (%s checkpoints): scoring %.3f, return %.3f\n", n, w, r / n, g / n }'
+fi
 printf '\n%d of %d seeds reached scoring >= %s with <= %s steps to goal (%d episodes each)\n' \
   "$met" "${#seed_list[@]}" "$target_rate" "$target_steps" "$episodes"
 [[ $ran -eq ${#seed_list[@]} && $failed -eq 0 ]] || exit 1

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -1030,6 +1031,36 @@ TEST(Config, PaperPresetIsTheDefault) {
       app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/paper.toml", {});
   EXPECT_EQ(app::to_toml(paper), app::to_toml(app::ExperimentConfig{}));
   EXPECT_NO_THROW(app::load_experiment_config(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/fast.toml", {}));
+}
+
+// Every preset loads, and one named <task>-<learner>.toml (issue 29's convention) trains that
+// learner on that task.
+TEST(Config, EveryPresetLoadsAndItsNameSaysItsTaskAndLearner) {
+  const std::map<std::string, std::string> learners = {{"paddpg", "ddpg"}, {"pdqn", "pdqn"}, {"mpdqn", "mpdqn"}};
+  const std::map<std::string, std::string> tasks = {{"platform", "platform"}, {"goal", "goal"}, {"hfo", "hfo"}};
+  int named = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs")) {
+    if (entry.path().extension() != ".toml") continue;
+    SCOPED_TRACE(entry.path().string());
+    std::optional<app::ExperimentConfig> loaded;
+    try {
+      loaded = app::load_experiment_config(entry.path().string(), {});
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << e.what();
+      continue;
+    }
+    const app::ExperimentConfig& c = *loaded;
+    const std::string stem = entry.path().stem().string();
+    const auto dash = stem.rfind('-');
+    if (dash == std::string::npos) continue;
+    const auto task = tasks.find(stem.substr(0, dash));
+    const auto learner = learners.find(stem.substr(dash + 1));
+    if (task == tasks.end() || learner == learners.end()) continue;
+    EXPECT_EQ(c.env.name, task->second);
+    EXPECT_EQ(c.train.algorithm, learner->second);
+    ++named;
+  }
+  EXPECT_EQ(named, 9);  // three tasks by three learners (hfo-paddpg.toml is fast.toml)
 }
 
 void expect_error(const std::string& text, const std::vector<std::string>& sets, const std::string& needle) {

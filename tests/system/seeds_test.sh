@@ -22,6 +22,18 @@ out=$(PAMDP_BIN=$bin bash "$src/bench/seeds.sh" --config "$src/deploy/configs/re
   --episodes 200 --target-rate 0.9 --target-steps 0.5 --out "$work/a" 2>/dev/null) || fail "rerun failed: $out"
 grep -q '^0 of 2 seeds reached' <<<"$out" || fail "an unreachable target must be counted as missed: $out"
 
+# MP-DQN's protocol: the final policies, with the mean return over the seeds after the rows.
+out=$(PAMDP_BIN=$bin bash "$src/bench/seeds.sh" --config "$src/deploy/configs/reach_stop.toml" --seeds 1,2 \
+  --episodes 200 --checkpoint final --out "$work/a" 2>/dev/null) || fail "--checkpoint final failed: $out"
+grep -q '^| config | .*scoring (200 ep, final) .*| mean return |' <<<"$out" || fail "no final-policy header: $out"
+grep -qE '^mean over 2 seeds \(final checkpoints\): scoring (0\.9[0-9]*|1\.000), return ' <<<"$out" ||
+  fail "no mean over the seeds: $out"
+
+if err=$(bash "$src/bench/seeds.sh" --checkpoint last 2>&1); then
+  fail "--checkpoint last accepted"
+fi
+grep -q -- "--checkpoint" <<<"$err" || fail "the error does not name --checkpoint: $err"
+
 if err=$(bash "$src/bench/seeds.sh" --seeds 1,x 2>&1); then
   fail "--seeds 1,x accepted"
 fi
