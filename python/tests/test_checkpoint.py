@@ -19,6 +19,7 @@ PAMDP = SOURCE = None
 CASES = [  # (checkpoint, episodes, seed): few episodes, so that the test takes seconds
     # (path, episodes, seed, a goal rate it beats: the policy plays, it is not a random one)
     ("models/hfo-1v0-fast-eps005-seed2.ckpt", 100, 1, 0.5),  # README's bold row: 1.000 / 72.1
+    ("models/hfo-1v0-mpdqn-seed1.ckpt", 100, 1, 0.5),  # MP-DQN's parameter and Q-networks
     # Against agent2d's goalie, which it was not trained against; plays its actor average.
     ("models/hfo-1v1-side-seed2.ckpt", 60, 3, 0.01),
 ]
