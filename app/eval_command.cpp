@@ -180,18 +180,30 @@ EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, cons
   return r;
 }
 
-// The simulator flags set env.* keys; an env that does not read one (hfo-server: the server's own
-// flags set up its game) refuses the flag rather than ignoring it.
+// The simulator flags and the env.* keys they set. An env that does not read one (hfo-server: the
+// server's own flags set up its game) refuses the flag rather than ignoring it.
+constexpr std::pair<const char*, const char*> kSimFlags[] = {
+    {"--no-noise", "noise"},           {"--start", "start"},         {"--referee", "referee"},
+    {"--body-reset", "body_at_reset"}, {"--max-steps", "max_steps"}, {"--untouched-limit", "untouched_limit"}};
+
 void refuse_unread_sim_options(const CLI::App& cmd, const std::string& env) {
-  const std::pair<const char*, const char*> flags[] = {{"--no-noise", "noise"},
-                                                       {"--start", "start"},
-                                                       {"--referee", "referee"},
-                                                       {"--body-reset", "body_at_reset"},
-                                                       {"--untouched-limit", "untouched_limit"}};
-  for (const auto& [flag, key] : flags) {
+  for (const auto& [flag, key] : kSimFlags) {
     if (cmd.count(flag) > 0 && !env_registry().reads(env, key)) {
       throw std::runtime_error(std::string(flag) + " sets env." + key + ", which env '" + env +
                                "' does not read: " + env_registry().find(env).description);
+    }
+  }
+}
+
+// A checkpoint is played on its run's env settings, except those a simulator flag given on the
+// command line changes (--start hfo: the real server's start distribution).
+void apply_given_sim_options(const CLI::App& cmd, const SimOptions& sim, EnvConfig& env) {
+  refuse_unread_sim_options(cmd, env.name);
+  EnvParams given;
+  hfo::set_sim_config(given, sim.resolved());
+  for (const auto& [flag, key] : kSimFlags) {
+    if (cmd.count(flag) > 0) {
+      env.params.set(key, given.at(key));
     }
   }
 }
@@ -230,10 +242,7 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
     }
   }
   c = with_env_overrides(c, o.sets);
-  refuse_unread_sim_options(cmd, c.env.name);
-  if (o.sim.no_noise) {
-    c.env.params.set("noise", false);
-  }
+  apply_given_sim_options(cmd, o.sim, c.env);
   if (o.sim.config.goalie && !c.env.params.boolean("goalie")) {
     throw std::runtime_error("--goalie: " + o.checkpoint +
                              " was trained without a goalie (env.goalie = false, 58 features); a checkpoint is "
@@ -355,7 +364,8 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--seed", opts->seed, "random seed of the evaluation")->capture_default_str();
   cmd->add_flag("--json", opts->json, "print one JSON object as the last line");
   cmd->add_option("--checkpoint", opts->checkpoint,
-                  "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used)")
+                  "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used, but "
+                  "for those a simulator flag given here changes, e.g. --start hfo)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--env", opts->env,
                   "play on this env instead: " + env_registry().names_joined() +

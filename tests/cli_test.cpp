@@ -193,6 +193,25 @@ TEST(Cli, EvalTraceWritesOneRowPerStep) {
 
 // --actor target plays the checkpoint's target actor: a different network from the online one
 // (so a different result on the same episodes), and still the trained agent (it scores).
+// A simulator flag given with --checkpoint changes that setting of the checkpoint's env: --start hfo
+// plays the real server's start distribution, exactly as --set env.start=hfo does, and not the
+// paper's starts the run was trained on; --max-steps likewise.
+TEST(Cli, EvalCheckpointTakesTheSimulatorFlagsGiven) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
+  const std::string eval = "eval --checkpoint " + model + " --episodes 30 --json";
+  const RunResult own = run_pamdp(eval, Capture::kStdoutOnly);
+  const RunResult flag = run_pamdp(eval + " --start hfo", Capture::kStdoutOnly);
+  const RunResult set = run_pamdp(eval + " --set env.start=hfo", Capture::kStdoutOnly);
+  ASSERT_EQ(own.exit_code, 0) << own.output;
+  ASSERT_EQ(flag.exit_code, 0) << flag.output;
+  ASSERT_EQ(set.exit_code, 0) << set.output;
+  EXPECT_NE(last_line(own.output), last_line(flag.output));
+  EXPECT_EQ(last_line(flag.output), last_line(set.output));
+  const RunResult short_episodes = run_pamdp(eval + " --max-steps 20", Capture::kStdoutOnly);
+  ASSERT_EQ(short_episodes.exit_code, 0) << short_episodes.output;
+  EXPECT_LE(nlohmann::json::parse(last_line(short_episodes.output)).at("avg_steps").get<double>(), 21.0);
+}
+
 TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
   const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
   const RunResult online = run_pamdp("eval --checkpoint " + model + " --episodes 30 --json", Capture::kStdoutOnly);
