@@ -191,8 +191,6 @@ TEST(Cli, EvalTraceWritesOneRowPerStep) {
   std::filesystem::remove_all(dir);
 }
 
-// --actor target plays the checkpoint's target actor: a different network from the online one
-// (so a different result on the same episodes), and still the trained agent (it scores).
 // A simulator flag given with --checkpoint changes that setting of the checkpoint's env: --start hfo
 // plays the real server's start distribution, exactly as --set env.start=hfo does, and not the
 // paper's starts the run was trained on; --max-steps likewise.
@@ -212,6 +210,8 @@ TEST(Cli, EvalCheckpointTakesTheSimulatorFlagsGiven) {
   EXPECT_LE(nlohmann::json::parse(last_line(short_episodes.output)).at("avg_steps").get<double>(), 21.0);
 }
 
+// --actor target plays the checkpoint's target actor: a different network from the online one
+// (so a different result on the same episodes), and still the trained agent (it scores).
 TEST(Cli, EvalActorTargetPlaysTheTargetNetwork) {
   const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v0-fast-seed1.ckpt";
   const RunResult online = run_pamdp("eval --checkpoint " + model + " --episodes 30 --json", Capture::kStdoutOnly);
