@@ -59,6 +59,7 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
   }
   bound_lo_ = lo_;
   bound_hi_ = hi_;
+  uniform_random_params_ = config.uniform_random_params;
   if (!(config.param_noise >= 0.0 && config.param_noise <= 1.0)) {
     throw std::invalid_argument(
         "exploration: param_noise must lie in [0, 1] (a fraction of each parameter's half range)");
@@ -95,8 +96,12 @@ int EpsilonGreedy::select(std::span<const float> net_output, double epsilon, std
     for (int a = 0; a < num_actions_; ++a) {
       stored[static_cast<size_t>(a)] = static_cast<float>(rng_.uniform(-1.0, 1.0));
     }
-    for (size_t i = 0; i < lo_.size(); ++i) {
-      stored[static_cast<size_t>(num_actions_) + i] = static_cast<float>(rng_.uniform(lo_[i], hi_[i]));
+    if (uniform_random_params_) {
+      for (size_t i = 0; i < lo_.size(); ++i) {
+        stored[static_cast<size_t>(num_actions_) + i] = static_cast<float>(rng_.uniform(lo_[i], hi_[i]));
+      }
+    } else {
+      std::copy(net_output.begin() + num_actions_, net_output.end(), stored.begin() + num_actions_);
     }
   } else {
     std::copy(net_output.begin(), net_output.end(), stored.begin());

@@ -5,7 +5,9 @@
 // vector unclipped (the env clamps and wraps them).
 // ε-greedy: with probability ε the whole output vector is replaced by a random one (scores
 // U[-1, 1], each parameter uniform in its exploration range), and the stored transition
-// carries that random vector.
+// carries that random vector. With uniform_random_params off, only the scores are drawn: the
+// random action keeps the policy's own parameters (MP-DQN's runs, which explore the parameters
+// with Ornstein-Uhlenbeck noise of σ 0.0001 instead: cycraig/MP-DQN agents/pdqn.py act()).
 // Parameter noise (param_noise > 0, not in the paper): on the other, greedy steps each
 // parameter gets Gaussian noise of std param_noise * (hi - lo) / 2 of its action-space bounds,
 // clamped to them; the discrete choice stays greedy and the stored vector carries the noise.
@@ -29,6 +31,8 @@ struct ExplorationConfig {
   // Sampling range of each parameter for random actions; empty = the action space's bounds.
   std::vector<float> random_param_lo;
   std::vector<float> random_param_hi;
+  // Whether a random step draws its parameters (true, the paper's) or keeps the policy's.
+  bool uniform_random_params = true;
   // Gaussian noise on the parameters of greedy steps, as a fraction of each parameter's half
   // range (0: none, the paper's pure ε-greedy).
   double param_noise = 0.0;
@@ -83,6 +87,7 @@ class EpsilonGreedy {
   std::vector<float> bound_lo_;  // the action space's bounds (parameter noise is clamped to them)
   std::vector<float> bound_hi_;
   std::vector<float> noise_std_;  // empty: no parameter noise
+  bool uniform_random_params_ = true;
   Rng rng_;
 };
 

@@ -1,4 +1,5 @@
-// P-DQN's and MP-DQN's acting policy: the parameter network "param" and the Q-network "q",
+// P-DQN's and MP-DQN's acting policy: the parameter network "param" and the Q-network "q", and
+// the fixed pass-through layer "param_passthrough" when the learner has one (pdqn.passthrough),
 // played through core/pdqn_output.hpp as the learner's own act() plays them; the parameters are
 // squashed into their bounds when the learner bounds by squashing (bound 2).
 #include <algorithm>
@@ -25,8 +26,15 @@ class PdqnActingPolicy final : public ActingPolicy {
         forward_(obs_dim, space, multipass) {}
 
   [[nodiscard]] const char* check(std::span<const NetworkView> networks, uint8_t bound) const override {
-    if (networks.size() != 2 || networks[0].name != "param" || networks[1].name != "q") {
-      return "P-DQN weights carry two networks, \"param\" and \"q\"";
+    if (networks.size() < 2 || networks.size() > 3 || networks[0].name != "param" || networks[1].name != "q" ||
+        (networks.size() == 3 && networks[2].name != "param_passthrough")) {
+      return "P-DQN weights carry the networks \"param\" and \"q\", and optionally \"param_passthrough\"";
+    }
+    if (networks.size() == 3) {
+      const std::span<const int> t = networks[2].widths;
+      if (t.size() != 2 || t.front() != obs_dim_ || t.back() != num_params_) {
+        return "the P-DQN pass-through layer's widths do not fit this env's observation and parameter widths";
+      }
     }
     const std::span<const int> p = networks[0].widths;
     const std::span<const int> q = networks[1].widths;
@@ -40,11 +48,16 @@ class PdqnActingPolicy final : public ActingPolicy {
   void load(std::span<const NetworkView> networks, uint8_t bound) override {
     take(networks[0], param_, 1);
     take(networks[1], q_, forward_.passes());
+    if (networks.size() == 3) {
+      take(networks[2], passthrough_, 1);
+    } else {
+      passthrough_.reset();
+    }
     squash_ = bound == kBoundSquashing;
   }
 
   void act(std::span<const float> obs, std::span<float> out) override {
-    forward_(*param_, *q_, squash_ ? &bounds_ : nullptr, obs, out);
+    forward_(*param_, *q_, squash_ ? &bounds_ : nullptr, obs, out, passthrough_.get());
   }
 
   [[nodiscard]] int64_t num_params() const override {
@@ -66,6 +79,7 @@ class PdqnActingPolicy final : public ActingPolicy {
   PdqnForward forward_;
   std::unique_ptr<Mlp<float>> param_;
   std::unique_ptr<Mlp<float>> q_;
+  std::unique_ptr<Mlp<float>> passthrough_;
   bool squash_ = false;
 };
 

@@ -81,6 +81,15 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("ddpg.demo_bc_weight", c.ddpg.demo_bc_weight, 0.0, 1e6);
   v.boolean("ddpg.demo_q_filter", c.ddpg.demo_q_filter);
   v.real("ddpg.actor_average_tau", c.ddpg.actor_average_tau, 0.0, 1.0);
+  // Each algorithm's own keys, as its registration declares them (learner/algorithm.hpp).
+  for (const AlgorithmKey& k : algorithm_registry().keys()) {
+    AlgorithmValue& value = c.algorithm_params.at(k.name);
+    if (k.is_boolean()) {
+      v.boolean(k.name, std::get<bool>(value));
+    } else {
+      v.real(k.name, std::get<double>(value), k.lo, k.hi);
+    }
+  }
 
   v.real("exploration.epsilon_start", c.exploration.epsilon_start, 0.0, 1.0);
   v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);
@@ -88,6 +97,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.str_list("exploration.masked_actions", c.masked_actions);
   v.ranges("exploration.random_param_ranges", c.random_param_ranges);
   v.real("exploration.param_noise", c.exploration.param_noise, 0.0, 1.0);
+  v.boolean("exploration.uniform_random_params", c.exploration.uniform_random_params);
   v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
   v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
   v.boolean("exploration.demo_relabel", c.exploration.demo_relabel);
@@ -564,6 +574,12 @@ std::unique_ptr<Algorithm> make_learner(const ExperimentConfig& config, int obs_
   args.seed = seed;
   args.device = device.value_or(config.ddpg.device);
   args.masked_actions = resolve_exploration(config, space).masked_actions;
+  args.params = &config.algorithm_params;
+  std::optional<ParameterPrior> prior;
+  if (const auto& of = env_registry().find(config.env.name).parameter_prior) {
+    prior = of(config.env.params);
+  }
+  args.prior = prior ? &*prior : nullptr;
   return make_algorithm(config.train.algorithm, args);
 }
 

@@ -79,6 +79,8 @@ struct ExperimentConfig {
   uint64_t seed = 1;
   EnvConfig env;
   DdpgConfig ddpg;
+  // The registered algorithms' own keys ("pdqn.q_tau"), every one whichever algorithm runs.
+  AlgorithmParams algorithm_params = algorithm_registry().defaults();
   ExplorationConfig exploration;
   std::vector<std::string> masked_actions = {"TACKLE"};
   // Random-action sampling ranges overriding the action-space bounds, by parameter name

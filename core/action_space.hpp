@@ -37,6 +37,16 @@ struct ActionSpace {
   [[nodiscard]] int find_action(std::string_view name) const;
 };
 
+// A hand-made policy for every continuous parameter, affine in the observation:
+// x = weights * obs + bias, in the parameters' units as the action space declares them. An env
+// may offer one (envs/registry.hpp, EnvRegistration::parameter_prior) for learners that start
+// from it (P-DQN's pass-through layer, pdqn.passthrough).
+struct ParameterPrior {
+  int obs_dim = 0;
+  std::vector<float> weights;  // num_params x obs_dim, row-major
+  std::vector<float> bias;     // num_params
+};
+
 // One chosen action: the discrete id and a view of the whole parameter vector (only the
 // entries the action owns are read). Non-owning; valid for the duration of a step() call.
 struct ParamAction {

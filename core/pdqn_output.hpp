@@ -39,24 +39,29 @@ class PdqnForward {
         multipass_(multipass),
         state_(obs_dim, 1),
         q_in_(obs_dim + space.num_params(), multipass ? space.num_actions() : 1),
-        x_(space.num_params()) {
+        x_(space.num_params()),
+        pre_(space.num_params()) {
     for (const DiscreteActionSpec& a : space.actions) {
       owned_.push_back(a.param_indices);
     }
   }
 
-  // `squash_into`: the parameter bounds when the learner squashes, else null. The networks must
-  // take batches of K (multi-pass) or 1 columns.
+  // `squash_into`: the parameter bounds when the learner squashes, else null. `passthrough`: a
+  // fixed linear layer added to the parameter network's output (before a squash), or null. The
+  // networks must take batches of K (multi-pass) or 1 columns.
   void operator()(Mlp<float>& param_net, Mlp<float>& q_net, const OutputBounds* squash_into, std::span<const float> obs,
-                  std::span<float> out) {
+                  std::span<float> out, Mlp<float>* passthrough = nullptr) {
     assert(static_cast<int>(obs.size()) == obs_dim_ && static_cast<int>(out.size()) == num_actions_ + num_params_);
     state_.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), obs_dim_);
-    const auto raw = param_net.forward(state_);
+    pre_ = param_net.forward(state_).col(0);
+    if (passthrough != nullptr) {
+      pre_ += passthrough->forward(state_).col(0);
+    }
     if (squash_into != nullptr) {
-      squash({raw.data(), static_cast<size_t>(num_params_)}, *squash_into,
+      squash({pre_.data(), static_cast<size_t>(num_params_)}, *squash_into,
              {x_.data(), static_cast<size_t>(num_params_)});
     } else {
-      x_ = raw.col(0);
+      x_ = pre_;
     }
     if (!multipass_) {
       q_in_.col(0).head(obs_dim_) = state_.col(0);
@@ -94,6 +99,7 @@ class PdqnForward {
   Eigen::MatrixXf state_;  // obs x 1
   Eigen::MatrixXf q_in_;   // (obs + P) x passes
   Eigen::VectorXf x_;      // P
+  Eigen::VectorXf pre_;    // P: before a squash
 };
 
 }  // namespace pamdp

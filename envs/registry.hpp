@@ -18,6 +18,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -91,6 +92,9 @@ struct EnvRegistration {
   // Where it plays, for start-up lines (" at localhost:6000"). Empty: in-process; an env that
   // plays elsewhere keeps a connection that making it anew would drop.
   std::function<std::string(const EnvParams&)> location;
+  // A hand-made policy for its parameters in these settings (core/action_space.hpp), which a
+  // learner may start from (pdqn.passthrough), or nullopt.
+  std::function<std::optional<ParameterPrior>(const EnvParams&)> parameter_prior;
   // Its action space is HFO's (DASH, TURN, KICK, TACKLE), which `pamdp eval`'s scripted and
   // random policies play.
   bool hfo_actions = false;

@@ -23,10 +23,12 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "core/action_space.hpp"
@@ -141,8 +143,43 @@ class Algorithm {
   virtual void warm_started() = 0;
 };
 
-// What a factory gets. The ddpg.* keys are the settings every learner reads today (network
-// widths, optimizer, discount, batch, target rate); an algorithm with more adds its own struct.
+// One setting an algorithm reads beyond the ddpg.* keys, declared at its registration as a full
+// config key, "<section>.<name>" ("pdqn.q_tau"). Algorithms that share a section (pdqn and mpdqn)
+// declare its keys alike; the config file accepts and writes every registered key whichever
+// algorithm runs, so that a run directory's config reads back unchanged.
+using AlgorithmValue = std::variant<bool, double>;
+
+struct AlgorithmKey {
+  std::string name;  // "pdqn.q_tau"
+  AlgorithmValue default_value;
+  double lo = 0.0;  // a real key's valid range, inclusive
+  double hi = 0.0;
+  std::string help;  // one line: what it does, for listings and the presets
+
+  static AlgorithmKey real(std::string name, double default_value, double lo, double hi, std::string help);
+  static AlgorithmKey boolean(std::string name, bool default_value, std::string help);
+  [[nodiscard]] bool is_boolean() const { return std::holds_alternative<bool>(default_value); }
+  bool operator==(const AlgorithmKey&) const = default;
+};
+
+// The values of the registered algorithms' keys, by full name. Reading a key that is absent or of
+// the other type is misuse: std::logic_error naming it.
+class AlgorithmParams {
+ public:
+  [[nodiscard]] double real(std::string_view key) const;
+  [[nodiscard]] bool boolean(std::string_view key) const;
+  void set(const std::string& key, AlgorithmValue value);
+  [[nodiscard]] AlgorithmValue& at(std::string_view key);  // for the config reader: a key that exists
+  [[nodiscard]] const std::map<std::string, AlgorithmValue, std::less<>>& values() const { return values_; }
+  bool operator==(const AlgorithmParams&) const = default;
+
+ private:
+  std::map<std::string, AlgorithmValue, std::less<>> values_;
+};
+
+// What a factory gets. The ddpg.* keys are the settings every learner reads (network widths,
+// optimizer, discount, batch, target rate); an algorithm with more declares its own keys at
+// registration and reads them from `params`.
 struct AlgorithmArgs {
   int obs_dim = 0;
   const ActionSpace* space = nullptr;
@@ -153,26 +190,37 @@ struct AlgorithmArgs {
   // Actions never taken (exploration.masked_actions, resolved): a value-based learner leaves them
   // out of its max.
   std::vector<int> masked_actions;
+  // The registered algorithms' own keys; null: their defaults.
+  const AlgorithmParams* params = nullptr;
+  // The env's hand-made parameter policy, when it has one (envs/registry.hpp): what a learner
+  // that starts its parameters from one (pdqn.passthrough) starts from.
+  const ParameterPrior* prior = nullptr;
 };
 
 struct AlgorithmRegistration {
   std::string name;         // train.algorithm
   std::string description;  // one line, for listings
   std::function<std::unique_ptr<Algorithm>(const AlgorithmArgs&)> make;
+  std::vector<AlgorithmKey> keys;  // the settings it reads beyond ddpg.*
 };
 
 class AlgorithmRegistry {
  public:
-  // Throws std::logic_error when the name is taken.
+  // Throws std::logic_error when the name is taken, or a key is declared unlike an earlier
+  // registration's key of the same name.
   void add(AlgorithmRegistration registration);
   // Null when no algorithm has this name.
   [[nodiscard]] const AlgorithmRegistration* find(std::string_view name) const;
   [[nodiscard]] const std::vector<AlgorithmRegistration>& all() const { return registrations_; }
   // The names, comma-separated, for error messages.
   [[nodiscard]] std::string names() const;
+  // Every key any algorithm reads, each once, in registration order, and their defaults.
+  [[nodiscard]] const std::vector<AlgorithmKey>& keys() const { return keys_; }
+  [[nodiscard]] AlgorithmParams defaults() const;
 
  private:
   std::vector<AlgorithmRegistration> registrations_;
+  std::vector<AlgorithmKey> keys_;
 };
 
 // Every algorithm this build offers (built on first use; thread-safe).

@@ -43,15 +43,62 @@ const DdpgConfig& checked(const DdpgConfig& c, bool multipass) {
   return c;
 }
 
+const PdqnSettings& checked(const PdqnSettings& s, const ParameterPrior* prior, int obs_dim, int num_params) {
+  if (s.passthrough) {
+    if (prior == nullptr) {
+      throw std::invalid_argument(
+          "pdqn.passthrough = true starts the parameters from the env's hand-made parameter policy, and this env has "
+          "none (envs/registry.hpp, parameter_prior); set pdqn.passthrough = false");
+    }
+    if (prior->obs_dim != obs_dim || prior->bias.size() != static_cast<size_t>(num_params) ||
+        prior->weights.size() != static_cast<size_t>(obs_dim) * static_cast<size_t>(num_params)) {
+      throw std::invalid_argument(
+          "pdqn.passthrough: the env's parameter policy does not fit its observation and "
+          "parameter widths");
+    }
+  }
+  return s;
+}
+
+constexpr const char* kQTau = "pdqn.q_tau";
+constexpr const char* kParamTau = "pdqn.param_tau";
+constexpr const char* kRewardScale = "pdqn.reward_scale";
+constexpr const char* kPassthrough = "pdqn.passthrough";
+constexpr const char* kParamOutputInitStd = "pdqn.param_output_init_std";
+
 }  // namespace
 
+std::vector<AlgorithmKey> pdqn_keys() {
+  return {
+      AlgorithmKey::real(kQTau, 0.0, 0.0, 1.0, "the Q-network's target rate; 0: ddpg.tau"),
+      AlgorithmKey::real(kParamTau, 0.0, 0.0, 1.0, "the parameter network's target rate; 0: ddpg.tau"),
+      AlgorithmKey::real(kRewardScale, 1.0, 1e-9, 1e9,
+                         "rewards (and Monte-Carlo returns) are multiplied by this in the Q target"),
+      AlgorithmKey::boolean(kPassthrough, false,
+                            "add the env's hand-made parameter policy to the parameter network as a fixed layer"),
+      AlgorithmKey::real(kParamOutputInitStd, 0.0, 0.0, 10.0,
+                         "the parameter network's output-layer initial weight scale; 0: ddpg.init_std"),
+  };
+}
+
+PdqnSettings PdqnSettings::from(const AlgorithmParams& params) {
+  PdqnSettings s;
+  s.q_tau = params.real(kQTau);
+  s.param_tau = params.real(kParamTau);
+  s.reward_scale = params.real(kRewardScale);
+  s.passthrough = params.boolean(kPassthrough);
+  s.param_output_init_std = params.real(kParamOutputInitStd);
+  return s;
+}
+
 Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, bool multipass,
-           std::vector<int> masked_actions)
+           std::vector<int> masked_actions, const PdqnSettings& settings, const ParameterPrior* prior)
     : obs_dim_(obs_dim),
       num_actions_(space.num_actions()),
       num_params_(space.num_params()),
       multipass_(multipass),
       config_(checked(config, multipass)),
+      settings_(checked(settings, prior, obs_dim, space.num_params())),
       param_bounds_(parameter_bounds(space)),
       masked_(static_cast<size_t>(space.num_actions()), false),
       owner_(static_cast<size_t>(space.num_params()), 0),
@@ -60,10 +107,12 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
          (multipass ? space.num_actions() : 1) * config.batch_size),
       target_param_(param_.widths(), config.batch_size),
       target_q_(q_.widths(), (multipass ? space.num_actions() : 1) * config.batch_size),
+      passthrough_({obs_dim, space.num_params()}, config.batch_size),
       param_adam_(param_.num_params(), adam(config, config.actor_learning_rate)),
       q_adam_(q_.num_params(), adam(config, config.critic_learning_rate)),
       forward_(obs_dim, space, multipass),
       x_(space.num_params(), config.batch_size),
+      pre_(space.num_params(), config.batch_size),
       q_in_(obs_dim + space.num_params(), (multipass ? space.num_actions() : 1) * config.batch_size),
       d_q_(space.num_actions(), (multipass ? space.num_actions() : 1) * config.batch_size),
       d_x_(space.num_params(), config.batch_size),
@@ -88,27 +137,48 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   }
   Rng rng(seed);
   const auto s = static_cast<float>(config.init_std);
-  param_.init_gaussian(rng, s);
+  param_.init_gaussian(rng, s, static_cast<float>(settings_.param_output_init_std));
   q_.init_gaussian(rng, s, static_cast<float>(config.critic_output_init_std),
                    static_cast<float>(config.critic_output_init_bias));
   std::copy(param_.params().begin(), param_.params().end(), target_param_.params().begin());
   std::copy(q_.params().begin(), q_.params().end(), target_q_.params().begin());
+  std::fill(passthrough_.params().begin(), passthrough_.params().end(), 0.0F);
+  if (settings_.passthrough) {
+    for (int p = 0; p < num_params_; ++p) {
+      for (int j = 0; j < obs_dim_; ++j) {
+        passthrough_.weight(0)(p, j) = prior->weights[static_cast<size_t>(p * obs_dim_ + j)];
+      }
+      passthrough_.bias(0)(p) = prior->bias[static_cast<size_t>(p)];
+    }
+  }
 }
 
 void Pdqn::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
   const bool target = copy == ActorCopy::kTarget;
   forward_(target ? target_param_ : param_, target ? target_q_ : q_,
-           config_.bound == BoundMethod::kSquashing ? &param_bounds_ : nullptr, obs, out);
+           config_.bound == BoundMethod::kSquashing ? &param_bounds_ : nullptr, obs, out,
+           settings_.passthrough ? &passthrough_ : nullptr);
 }
 
 ActingWeights Pdqn::acting_weights() {
-  return {name(),
-          static_cast<uint8_t>(config_.bound),
-          {{"param", param_.widths(), param_.params()}, {"q", q_.widths(), q_.params()}}};
+  ActingWeights w{name(),
+                  static_cast<uint8_t>(config_.bound),
+                  {{"param", param_.widths(), param_.params()}, {"q", q_.widths(), q_.params()}}};
+  if (settings_.passthrough) {
+    w.networks.push_back({"param_passthrough", passthrough_.widths(), passthrough_.params()});
+  }
+  return w;
 }
 
 void Pdqn::parameters_of(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int B) {
-  const auto raw = net.forward(states.leftCols(B));
+  const auto net_out = net.forward(states.leftCols(B));
+  if (settings_.passthrough) {
+    pre_.leftCols(B) = net_out;
+    pre_.leftCols(B) += passthrough_.forward(states.leftCols(B));
+  }
+  const Eigen::Ref<const Eigen::MatrixXf> raw = settings_.passthrough
+                                                    ? Eigen::Ref<const Eigen::MatrixXf>(pre_.leftCols(B))
+                                                    : Eigen::Ref<const Eigen::MatrixXf>(net_out);
   if (config_.bound == BoundMethod::kSquashing) {
     for (int j = 0; j < B; ++j) {
       squash({raw.col(j).data(), static_cast<size_t>(num_params_)}, param_bounds_,
@@ -157,6 +227,7 @@ void Pdqn::targets(const BatchView& batch, int B) {
   const auto q_next = target_q_.forward(q_in_.leftCols(cols));
   const auto g = static_cast<float>(config_.gamma);
   const auto beta = static_cast<float>(config_.mc_mix);
+  const auto scale = static_cast<float>(settings_.reward_scale);
   for (int j = 0; j < B; ++j) {
     float best = -std::numeric_limits<float>::infinity();
     for (int k = 0; k < num_actions_; ++k) {
@@ -164,9 +235,9 @@ void Pdqn::targets(const BatchView& batch, int B) {
         best = std::max(best, q_of(q_next, k, j, B));
       }
     }
-    float y = batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * best);
+    float y = scale * batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * best);
     if (beta > 0.0F) {
-      y = beta * batch.mc_returns(j) + (1.0F - beta) * y;
+      y = beta * scale * batch.mc_returns(j) + (1.0F - beta) * y;
     }
     y_(j) = y;
   }
@@ -234,7 +305,11 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
       d_x_(p, j) = in_grad(obs_dim_ + p, col);
     }
   }
-  apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), param_.output(), d_x_.leftCols(B));
+  if (settings_.passthrough) {
+    apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), pre_.leftCols(B), d_x_.leftCols(B));
+  } else {
+    apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), param_.output(), d_x_.leftCols(B));
+  }
   param_.backward(d_x_.leftCols(B), false);
   return loss / B;
 }
@@ -294,8 +369,9 @@ UpdateStats Pdqn::update(const BatchView& batch, const BatchView* /*demos*/) {
   param_step_gradient(batch, B, stats);  // through the just-updated Q-network
   stats.actor_grad_norm = static_cast<float>(clip_global_norm(param_.grads(), config_.clip_grad_norm));
   param_adam_.step(param_.params(), param_.grads());
-  soft_update<float>(target_param_.params(), param_.params(), config_.tau);
-  soft_update<float>(target_q_.params(), q_.params(), config_.tau);
+  soft_update<float>(target_param_.params(), param_.params(),
+                     settings_.param_tau > 0.0 ? settings_.param_tau : config_.tau);
+  soft_update<float>(target_q_.params(), q_.params(), settings_.q_tau > 0.0 ? settings_.q_tau : config_.tau);
   ++updates_;
   last_ = stats;
   return stats;
@@ -314,6 +390,9 @@ std::vector<StateTensor> Pdqn::state_tensors() {
   net("target_q", target_q_);
   moments("param_adam", param_adam_);
   moments("q_adam", q_adam_);
+  if (settings_.passthrough) {
+    t.push_back({"param_passthrough", passthrough_.params(), {}, false});
+  }
   return t;
 }
 
@@ -334,8 +413,12 @@ void register_pdqn_algorithms(AlgorithmRegistry& registry) {
                   multipass ? "MP-DQN: P-DQN with one Q pass per action (Bester, James & Konidaris 2019)"
                             : "P-DQN: a Q-network over all parameters and a parameter network (Xiong et al. 2018)",
                   [multipass](const AlgorithmArgs& a) {
-                    return std::make_unique<Pdqn>(a.obs_dim, *a.space, *a.ddpg, a.seed, multipass, a.masked_actions);
-                  }});
+                    const PdqnSettings settings =
+                        PdqnSettings::from(a.params != nullptr ? *a.params : algorithm_registry().defaults());
+                    return std::make_unique<Pdqn>(a.obs_dim, *a.space, *a.ddpg, a.seed, multipass, a.masked_actions,
+                                                  settings, a.prior);
+                  },
+                  pdqn_keys()});
   }
 }
 

@@ -17,7 +17,9 @@
 //   3. parameter step on L = -(1 / B) Σ_batch Σ_k Q(s, k, x(s)) over the unmasked k, through the
 //      updated Q-network (its parameter gradients discarded), the gradient on x kept in bounds by
 //      ddpg.bound (inverting by default, as cycraig/MP-DQN; squashing squashes x);
-//   4. soft target updates at rate ddpg.tau.
+//   4. soft target updates at rate ddpg.tau (pdqn.q_tau, pdqn.param_tau when set).
+// Its own keys (declared at registration, the [pdqn] section, shared by both): separate target
+// rates for the two networks, a reward scale, and MP-DQN's pass-through layer (PdqnSettings).
 // It reads the ddpg.* settings (hidden widths for both networks, learning rates: actor for the
 // parameter network, critic for the Q-network, Adam, γ, τ, batch, clipping, bound, Monte-Carlo
 // mix, learning-rate decay, initialisation). It neither clones demonstrations nor keeps an
@@ -25,7 +27,8 @@
 //
 // State names: networks "param", "q", "target_param", "target_q"; Adam moments "param_adam.m",
 // "param_adam.v", "q_adam.m", "q_adam.v"; counters "updates", "param_adam.steps",
-// "q_adam.steps". The actors get "param" and "q". update() allocates nothing.
+// "q_adam.steps"; with the pass-through layer, "param_passthrough" too. The actors get "param"
+// and "q", and "param_passthrough" with the layer. update() allocates nothing.
 #pragma once
 
 #include <Eigen/Core>
@@ -41,11 +44,32 @@
 
 namespace pamdp {
 
+// The [pdqn] keys (pdqn_keys() declares them for the config file).
+struct PdqnSettings {
+  double q_tau = 0.0;      // the Q-network's target rate; 0: ddpg.tau
+  double param_tau = 0.0;  // the parameter network's; 0: ddpg.tau
+  // Rewards, and Monte-Carlo returns, are multiplied by this where they enter the Q target
+  // (MP-DQN scales Goal's by 1/50). Returns and evaluations report the env's own rewards.
+  double reward_scale = 1.0;
+  // MP-DQN's pass-through layer (cycraig/MP-DQN agents/pdqn.py, action_parameters_passthrough_layer):
+  // x(s) = net(s) + W s + b, with W and b the env's hand-made parameter policy
+  // (AlgorithmArgs::prior), fixed for the whole run. The net's output layer then starts small
+  // (param_output_init_std), so that x(s) starts at the hand-made policy.
+  bool passthrough = false;
+  double param_output_init_std = 0.0;  // the parameter network's output-layer weights; 0: ddpg.init_std
+
+  static PdqnSettings from(const AlgorithmParams& params);
+};
+
+// The keys above, as the registration declares them.
+std::vector<AlgorithmKey> pdqn_keys();
+
 class Pdqn final : public Algorithm {
  public:
   // `masked_actions` are never taken (HFO's Tackle): left out of the max and of the parameter loss.
+  // `prior` is read when settings.passthrough (std::invalid_argument when it is null).
   Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, bool multipass,
-       std::vector<int> masked_actions = {});
+       std::vector<int> masked_actions = {}, const PdqnSettings& settings = {}, const ParameterPrior* prior = nullptr);
 
   [[nodiscard]] std::string_view name() const override { return multipass_ ? "mpdqn" : "pdqn"; }
   [[nodiscard]] int obs_dim() const override { return obs_dim_; }
@@ -82,6 +106,8 @@ class Pdqn final : public Algorithm {
   Mlp<float>& q_net() { return q_; }
   Mlp<float>& target_param_net() { return target_param_; }
   Mlp<float>& target_q_net() { return target_q_; }
+  // The fixed pass-through layer (widths {obs, P}); all zeros without settings.passthrough.
+  Mlp<float>& passthrough_net() { return passthrough_; }
 
  private:
   // x(s) for the batch's states into x_ (and the raw outputs in the network).
@@ -106,6 +132,7 @@ class Pdqn final : public Algorithm {
   int num_params_;
   bool multipass_;
   DdpgConfig config_;
+  PdqnSettings settings_;
   OutputBounds param_bounds_;
   std::vector<bool> masked_;
   std::vector<int> owner_;  // per parameter: the action that owns it
@@ -114,6 +141,7 @@ class Pdqn final : public Algorithm {
   Mlp<float> q_;
   Mlp<float> target_param_;
   Mlp<float> target_q_;
+  Mlp<float> passthrough_;  // shared by the parameter network and its target
   Adam<float> param_adam_;
   Adam<float> q_adam_;
   int64_t updates_ = 0;
@@ -123,6 +151,7 @@ class Pdqn final : public Algorithm {
 
   // Scratch, sized in the constructor for batch_size.
   Eigen::MatrixXf x_;       // P x B: parameters fed to the Q-network
+  Eigen::MatrixXf pre_;     // P x B: net(s) + passthrough(s), before a squash (with the layer)
   Eigen::MatrixXf q_in_;    // (obs + P) x (K * B)
   Eigen::MatrixXf d_q_;     // K x (K * B)
   Eigen::MatrixXf d_x_;     // P x B

@@ -69,6 +69,13 @@ std::vector<EnvCase> env_cases() {
     const EnvParams defaults = env_registry().defaults();
     cases.push_back(
         {name, [&r, defaults] { return r.make(defaults); }, r.observation_size(defaults), r.observation_bound, 30});
+    // An env that can show its parameters over [-1, 1] (envs/scaled_parameters.hpp) passes as that too.
+    if (env_registry().reads(r.name, "scaled_parameters")) {
+      EnvParams scaled = defaults;
+      scaled.set("scaled_parameters", true);
+      cases.push_back({name + "_ScaledParameters", [&r, scaled] { return r.make(scaled); }, r.observation_size(scaled),
+                       r.observation_bound, 30});
+    }
   }
   return cases;
 }

@@ -200,6 +200,30 @@ TEST(Exploration, ParameterNoiseIsGaussianAroundTheGreedyParametersAndStaysInBou
   EXPECT_THROW(EpsilonGreedy(space, cfg, 5), std::invalid_argument);
 }
 
+// exploration.uniform_random_params = false (MP-DQN's runs): a random step draws the scores only
+// and keeps the network's parameters.
+TEST(Exploration, RandomActionsCanKeepThePolicysParameters) {
+  const ActionSpace& space = hfo::hfo_action_space();
+  ExplorationConfig cfg;
+  cfg.masked_actions = {hfo::kTackle};
+  cfg.uniform_random_params = false;
+  EpsilonGreedy eg(space, cfg, 3);
+  std::vector<float> net(10, 0.0F);
+  for (int i = 0; i < 6; ++i) {
+    net[static_cast<size_t>(4 + i)] = 10.0F + static_cast<float>(i);
+  }
+  std::vector<float> stored(10);
+  std::vector<int> counts(4, 0);
+  for (int i = 0; i < 3000; ++i) {
+    ++counts[static_cast<size_t>(eg.select(net, 1.0, stored))];
+    EXPECT_TRUE(std::equal(net.begin() + 4, net.end(), stored.begin() + 4));
+  }
+  EXPECT_EQ(counts[hfo::kTackle], 0);
+  for (int a : {hfo::kDash, hfo::kTurn, hfo::kKick}) {
+    EXPECT_NEAR(counts[static_cast<size_t>(a)] / 3000.0, 1.0 / 3.0, 0.045);
+  }
+}
+
 TEST(ReplayBuffer, FifoAndSampling) {
   ReplayBuffer rb(3, 1, 1);
   Rng rng(1);
@@ -1024,6 +1048,45 @@ TEST(Config, DefaultsRoundTripAndOverrides) {
   EXPECT_EQ(o.ddpg.bound, BoundMethod::kSquashing);
   EXPECT_FALSE(o.env.params.boolean("noise"));
   EXPECT_EQ(o.seed, 9U);
+}
+
+// An algorithm's own keys ([pdqn]) come from its registration: read, range-checked, written back,
+// and an unknown one in their section is refused naming the valid ones.
+TEST(Config, AlgorithmKeysComeFromTheirRegistration) {
+  const app::ExperimentConfig o =
+      app::parse_experiment_config("[pdqn]\nq_tau = 0.1\n", "x", {"pdqn.passthrough=true", "pdqn.reward_scale=0.02"});
+  EXPECT_DOUBLE_EQ(o.algorithm_params.real("pdqn.q_tau"), 0.1);
+  EXPECT_TRUE(o.algorithm_params.boolean("pdqn.passthrough"));
+  EXPECT_DOUBLE_EQ(o.algorithm_params.real("pdqn.reward_scale"), 0.02);
+  const app::ExperimentConfig back = app::parse_experiment_config(app::to_toml(o), "round-trip", {});
+  EXPECT_EQ(back.algorithm_params, o.algorithm_params);
+  EXPECT_DOUBLE_EQ(app::ExperimentConfig{}.algorithm_params.real("pdqn.reward_scale"), 1.0);
+  try {
+    app::parse_experiment_config("[pdqn]\nq_taus = 0.1\n", "cfg.toml", {});
+    FAIL() << "an unknown [pdqn] key was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("q_tau"), std::string::npos) << e.what();
+  }
+  try {
+    app::parse_experiment_config("", "cfg.toml", {"pdqn.q_tau=2"});
+    FAIL() << "pdqn.q_tau = 2 was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("pdqn.q_tau"), std::string::npos) << e.what();
+  }
+}
+
+// The registry refuses a key declared two ways, or one outside a section of its own.
+TEST(Config, AlgorithmKeysAreDeclaredOnce) {
+  const auto make = [](const AlgorithmArgs&) -> std::unique_ptr<Algorithm> { return nullptr; };
+  AlgorithmRegistry r;
+  r.add({"a", "", make, {AlgorithmKey::real("s.rate", 0.5, 0.0, 1.0, "")}});
+  EXPECT_NO_THROW(r.add({"b", "", make, {AlgorithmKey::real("s.rate", 0.5, 0.0, 1.0, "")}}));
+  EXPECT_THROW(r.add({"c", "", make, {AlgorithmKey::real("s.rate", 0.25, 0.0, 1.0, "")}}), std::logic_error);
+  EXPECT_THROW(r.add({"d", "", make, {AlgorithmKey::boolean("flag", true, "")}}), std::logic_error);
+  EXPECT_THROW(r.add({"e", "", make, {AlgorithmKey::boolean("ddpg.flag", true, "")}}), std::logic_error);
+  EXPECT_EQ(r.keys().size(), 1U);
+  EXPECT_DOUBLE_EQ(r.defaults().real("s.rate"), 0.5);
+  EXPECT_THROW((void)r.defaults().boolean("s.rate"), std::logic_error);
 }
 
 TEST(Config, PaperPresetIsTheDefault) {

@@ -295,5 +295,159 @@ TEST(Pdqn, RefusesSettingsItDoesNotHave) {
   }
 }
 
+// A random hand-made parameter policy for test_space() (3 parameters over kObs features).
+ParameterPrior random_prior(uint64_t seed) {
+  Rng rng(seed);
+  ParameterPrior p{kObs, std::vector<float>(3 * kObs), std::vector<float>(3)};
+  for (float& w : p.weights) {
+    w = static_cast<float>(rng.uniform(-1.0, 1.0));
+  }
+  for (float& b : p.bias) {
+    b = static_cast<float>(rng.uniform(-0.5, 0.5));
+  }
+  return p;
+}
+
+PdqnSettings with_passthrough(float output_std) {
+  PdqnSettings s;
+  s.passthrough = true;
+  s.param_output_init_std = output_std;
+  return s;
+}
+
+// With the pass-through layer the parameter network starts at the env's hand-made policy
+// (W s + b, its own output near zero), the layer stays fixed through updates, its gradients
+// match finite differences, and the actors play exactly what the learner acts.
+TEST(Pdqn, PassthroughStartsAtThePriorAndStaysFixed) {
+  const ActionSpace space = test_space();
+  const ParameterPrior prior = random_prior(4);
+  for (const bool multipass : {false, true}) {
+    Pdqn pdqn(kObs, space, small(BoundMethod::kInverting), 5, multipass, {}, with_passthrough(1e-6F), &prior);
+    std::vector<float> out(6);
+    const Eigen::Vector3f s(0.3F, -0.6F, 0.9F);
+    pdqn.act({s.data(), kObs}, out);
+    for (int p = 0; p < 3; ++p) {
+      float want = prior.bias[static_cast<size_t>(p)];
+      for (int j = 0; j < kObs; ++j) {
+        want += prior.weights[static_cast<size_t>(p * kObs + j)] * s(j);
+      }
+      EXPECT_NEAR(out[static_cast<size_t>(3 + p)], want, 1e-4) << "parameter " << p;
+    }
+    const std::vector<float> layer(pdqn.passthrough_net().params().begin(), pdqn.passthrough_net().params().end());
+    const Batch b;
+    for (int i = 0; i < 5; ++i) {
+      pdqn.update(b.view());
+    }
+    EXPECT_EQ(layer,
+              std::vector<float>(pdqn.passthrough_net().params().begin(), pdqn.passthrough_net().params().end()));
+
+    const ActingWeights w = pdqn.acting_weights();
+    ASSERT_EQ(w.networks.size(), 3U);
+    const std::unique_ptr<ActingPolicy> policy = acting_policy_registry().find(w.algorithm)->make(kObs, space);
+    ASSERT_EQ(policy->check(w.networks, w.bound), nullptr);
+    policy->load(w.networks, w.bound);
+    std::vector<float> theirs(6);
+    policy->act({s.data(), kObs}, theirs);
+    pdqn.act({s.data(), kObs}, out);
+    EXPECT_EQ(out, theirs);
+    // A layer of the wrong width is refused.
+    std::vector<NetworkView> wrong = w.networks;
+    const std::vector<int> widths{kObs + 1, 3};
+    wrong[2].widths = widths;
+    EXPECT_NE(policy->check(wrong, w.bound), nullptr);
+  }
+}
+
+TEST(Pdqn, PassthroughGradientsMatchFiniteDifferences) {
+  ActionSpace space = test_space();
+  for (ParamSpec& p : space.params) {
+    p.lo = -10.0F;
+    p.hi = 10.0F;
+  }
+  const ParameterPrior prior = random_prior(8);
+  for (const BoundMethod bound : {BoundMethod::kZeroing, BoundMethod::kSquashing}) {
+    Pdqn pdqn(kObs, space, small(bound), 3, true, {2}, with_passthrough(0.0F), &prior);
+    const Batch b;
+    const BatchView v = b.view();
+    pdqn.gradients(v);
+    expect_gradients(
+        pdqn.param_net(), [&] { return pdqn.losses(v).param_loss; }, "parameter loss with the pass-through layer");
+  }
+}
+
+// pdqn.reward_scale: the Q target is built from the scaled rewards and returns, exactly as if the
+// batch had carried them.
+TEST(Pdqn, RewardScaleScalesTheTarget) {
+  const ActionSpace space = test_space();
+  PdqnSettings scaled;
+  scaled.reward_scale = 0.02;
+  DdpgConfig config = small(BoundMethod::kInverting);
+  config.mc_mix = 0.25;
+  Pdqn a(kObs, space, config, 5, true, {}, scaled);
+  Pdqn plain(kObs, space, config, 5, true);
+  Batch b;
+  b.rewards *= 50.0F;
+  b.mc = Eigen::VectorXf::Random(kB) * 50.0F;
+  Batch by_hand = b;
+  by_hand.rewards *= 0.02F;
+  by_hand.mc *= 0.02F;
+  const double want = plain.losses(by_hand.view()).q_loss;
+  EXPECT_NEAR(a.losses(b.view()).q_loss, want, 1e-6 * (1.0 + want));
+  EXPECT_GT(std::abs(plain.losses(b.view()).q_loss - want), 1e-3);  // the scale matters here
+}
+
+// pdqn.q_tau and pdqn.param_tau move each target network at its own rate.
+TEST(Pdqn, EachNetworkHasItsOwnTargetRate) {
+  const ActionSpace space = test_space();
+  PdqnSettings rates;
+  rates.q_tau = 0.5;
+  rates.param_tau = 0.25;
+  Pdqn pdqn(kObs, space, small(BoundMethod::kInverting), 5, false, {}, rates);
+  Rng rng(2);
+  pdqn.target_q_net().init_gaussian(rng, 0.5F);
+  pdqn.target_param_net().init_gaussian(rng, 0.5F);
+  const auto copy = [](std::span<const float> v) { return std::vector<float>(v.begin(), v.end()); };
+  const std::vector<float> old_q = copy(pdqn.target_q_net().params());
+  const std::vector<float> old_param = copy(pdqn.target_param_net().params());
+  const Batch b;
+  pdqn.update(b.view());
+  for (size_t i = 0; i < old_q.size(); ++i) {
+    EXPECT_NEAR(pdqn.target_q_net().params()[i], 0.5F * old_q[i] + 0.5F * pdqn.q_net().params()[i], 1e-6) << i;
+  }
+  for (size_t i = 0; i < old_param.size(); ++i) {
+    EXPECT_NEAR(pdqn.target_param_net().params()[i], 0.75F * old_param[i] + 0.25F * pdqn.param_net().params()[i], 1e-6)
+        << i;
+  }
+}
+
+// The pass-through layer without a hand-made policy to start from is refused, naming the key.
+TEST(Pdqn, PassthroughNeedsTheEnvsPolicy) {
+  const ActionSpace space = test_space();
+  try {
+    Pdqn p(kObs, space, small(BoundMethod::kInverting), 1, false, {}, with_passthrough(0.0F), nullptr);
+    ADD_FAILURE() << "pdqn.passthrough was accepted without a policy";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("pdqn.passthrough"), std::string::npos) << e.what();
+  }
+}
+
+// The pass-through layer is part of the checkpoint: a learner built from another policy reads
+// the saved one back.
+TEST(Pdqn, PassthroughIsCheckpointed) {
+  const ActionSpace space = test_space();
+  const ParameterPrior prior = random_prior(4);
+  const ParameterPrior other = random_prior(5);
+  Pdqn saved(kObs, space, small(BoundMethod::kInverting), 5, true, {}, with_passthrough(0.0F), &prior);
+  const fs::path dir = fresh_dir("passthrough");
+  fs::create_directories(dir);
+  const std::string path = (dir / "p.ckpt").string();
+  save_checkpoint(path, saved, {});
+  Pdqn loaded(kObs, space, small(BoundMethod::kInverting), 6, true, {}, with_passthrough(0.0F), &other);
+  load_checkpoint(path, loaded);
+  EXPECT_TRUE(std::equal(saved.passthrough_net().params().begin(), saved.passthrough_net().params().end(),
+                         loaded.passthrough_net().params().begin()));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace pamdp
