@@ -2,6 +2,7 @@
 // 512 -> 256 -> 128 -> 4+6 actor, 68 -> ... -> 1 critic) at batch 32 (128, 1024) with inverting
 // gradients, through the learner's own Ddpg class; items = updates. The GPU versions are in
 // bench_ddpg_cuda.cpp. BM_DdpgUpdateFast/32: the same with fast.toml's widths (256-128-64).
+// BM_PdqnUpdate: P-DQN's and MP-DQN's update at those widths.
 // BM_GemmRoofline: float GEMM on this core through core/gemm.hpp (OpenBLAS where it was found,
 // the label says), the roofline the update is measured against (items = FLOP, so
 // items_per_second reads as FLOP/s). BM_GemmEigen: Eigen's own product on the same shapes, for
@@ -15,6 +16,7 @@
 #include "core/gemm.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/pdqn.hpp"
 
 namespace {
 
@@ -46,6 +48,29 @@ void BM_DdpgUpdateFast(benchmark::State& state) {
   update(state, {256, 128, 64});
 }
 BENCHMARK(BM_DdpgUpdateFast)->Arg(32)->Unit(benchmark::kMillisecond);
+
+// BM_PdqnUpdate/0 (/1): one P-DQN (MP-DQN) update with hfo-mpdqn.toml's networks (256-128-64
+// for both), batch 32, Tackle masked as HFO's presets mask it, through the learner's own Pdqn
+// class; items = updates. Read it against BM_DdpgUpdateFast/32 of the same run, which has the
+// same widths.
+void BM_PdqnUpdate(benchmark::State& state) {
+  const bool multipass = state.range(0) != 0;
+  pamdp::DdpgConfig cfg;
+  cfg.hidden = {256, 128, 64};
+  cfg.batch_size = 32;
+  cfg.bound = pamdp::BoundMethod::kInverting;
+  const pamdp::ActionSpace& space = pamdp::hfo::hfo_action_space();
+  pamdp::Pdqn pdqn(58, space, cfg, 1, multipass, {pamdp::hfo::kTackle});
+  const pamdp::bench::RandomHfoBatch data(32);
+  const pamdp::BatchView view = data.view();
+  for (auto _ : state) {
+    const pamdp::UpdateStats s = pdqn.update(view);
+    benchmark::DoNotOptimize(s.critic_loss);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(multipass ? "mpdqn" : "pdqn");
+}
+BENCHMARK(BM_PdqnUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate here, through the
 // update's own gemm() (eigen = false) or Eigen's product.

@@ -130,6 +130,7 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
     throw std::invalid_argument("every action is masked: unmask at least one (exploration.masked_actions)");
   }
   for (int k = 0; k < num_actions_; ++k) {
+    pass_.push_back(masked_[static_cast<size_t>(k)] ? -1 : num_passes_++);
     owned_.push_back(space.actions[static_cast<size_t>(k)].param_indices);
     for (const int p : owned_.back()) {
       owner_[static_cast<size_t>(p)] = k;
@@ -197,13 +198,17 @@ int Pdqn::fill_q_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Ei
     return B;
   }
   for (int k = 0; k < num_actions_; ++k) {
-    q_in_.block(0, k * B, obs_dim_, B) = states.leftCols(B);
-    q_in_.block(obs_dim_, k * B, num_params_, B).setZero();
+    const int pass = pass_[static_cast<size_t>(k)];
+    if (pass < 0) {
+      continue;  // a masked action's Q is never read
+    }
+    q_in_.block(0, pass * B, obs_dim_, B) = states.leftCols(B);
+    q_in_.block(obs_dim_, pass * B, num_params_, B).setZero();
     for (const int p : owned_[static_cast<size_t>(k)]) {
-      q_in_.block(obs_dim_ + p, k * B, 1, B) = x.block(p, 0, 1, B);
+      q_in_.block(obs_dim_ + p, pass * B, 1, B) = x.block(p, 0, 1, B);
     }
   }
-  return num_actions_ * B;
+  return num_passes_ * B;
 }
 
 void Pdqn::fill_taken_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
@@ -292,7 +297,7 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
     for (int k = 0; k < num_actions_; ++k) {
       if (!masked_[static_cast<size_t>(k)]) {
         loss -= q_of(q, k, j, B);
-        d_q_(k, multipass_ ? k * B + j : j) = per_sample;
+        d_q_(k, multipass_ ? pass_[static_cast<size_t>(k)] * B + j : j) = per_sample;
       }
     }
   }
@@ -300,9 +305,10 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
   const auto in_grad = q_.input_grad();
   for (int j = 0; j < B; ++j) {
     for (int p = 0; p < num_params_; ++p) {
-      // In a multi-pass batch x_p reaches Q only through the pass of the action that owns it.
-      const int col = multipass_ ? owner_[static_cast<size_t>(p)] * B + j : j;
-      d_x_(p, j) = in_grad(obs_dim_ + p, col);
+      // In a multi-pass batch x_p reaches Q only through the pass of the action that owns it (a
+      // masked action has none: its parameters get no gradient, as its Q is not in the loss).
+      const int pass = multipass_ ? pass_[static_cast<size_t>(owner_[static_cast<size_t>(p)])] : 0;
+      d_x_(p, j) = pass < 0 ? 0.0F : in_grad(obs_dim_ + p, pass * B + j);
     }
   }
   if (settings_.passthrough) {

@@ -112,15 +112,17 @@ class Pdqn final : public Algorithm {
  private:
   // x(s) for the batch's states into x_ (and the raw outputs in the network).
   void parameters_of(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int B);
-  // Q-network inputs for B states and the parameters in `x` (P x B): one pass, or K passes
-  // (pass k in columns k*B .. k*B + B - 1 holds only action k's parameters). Returns the columns.
+  // Q-network inputs for B states and the parameters in `x` (P x B): one pass, or one pass per
+  // unmasked action (action k's pass, pass_[k], in columns pass_[k]*B .. pass_[k]*B + B - 1,
+  // holds only its parameters; a masked action, never in the max nor the loss, gets none).
+  // Returns the columns.
   int fill_q_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x, int B);
   // The same for each sample's own action `taken_`: one column per sample.
   void fill_taken_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
                         int B);
   // Q(s, k, ·) of sample j from a forward over fill_q_input's columns.
   [[nodiscard]] float q_of(const Mlp<float>::ConstBlock& q, int k, int j, int B) const {
-    return multipass_ ? q(k, k * B + j) : q(k, j);
+    return multipass_ ? q(k, pass_[static_cast<size_t>(k)] * B + j) : q(k, j);
   }
   void targets(const BatchView& batch, int B);
   double q_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
@@ -137,6 +139,8 @@ class Pdqn final : public Algorithm {
   std::vector<bool> masked_;
   std::vector<int> owner_;  // per parameter: the action that owns it
   std::vector<std::vector<int>> owned_;
+  std::vector<int> pass_;  // per action: its pass in a multi-pass batch, -1 when masked
+  int num_passes_ = 0;
   Mlp<float> param_;
   Mlp<float> q_;
   Mlp<float> target_param_;
