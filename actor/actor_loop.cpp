@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "actor/acting_policy.hpp"
@@ -310,6 +311,11 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
     if (t >= next_control) {
       serve_control(t);
     }
+    if (policy == nullptr && !config.exploration.uniform_random_params) {
+      // Its random steps play the network's parameters, which it has not got yet.
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
     step(envs[k]);
     k = k + 1 == envs.size() ? 0 : k + 1;
   }
@@ -345,8 +351,9 @@ void ActorLoop::Impl::forward(std::span<const float> obs) {
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
   // At ε = 1 the network's output is never used, so it is not computed (a demonstration stores it
-  // as the parameters of the actions the teacher did not take).
-  if (policy != nullptr && (eps < 1.0 || slot.demo || slot.label)) {
+  // as the parameters of the actions the teacher did not take; a random step keeps its parameters
+  // when exploration.uniform_random_params is off).
+  if (policy != nullptr && (eps < 1.0 || slot.demo || slot.label || !config.exploration.uniform_random_params)) {
     forward(slot.obs);
   }
   const int id = slot.demo ? write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.stored)

@@ -61,7 +61,8 @@ class PdqnActingPolicy final : public ActingPolicy {
   }
 
   [[nodiscard]] int64_t num_params() const override {
-    return (param_ ? param_->num_params() : 0) + (q_ ? q_->num_params() : 0);
+    return (param_ ? param_->num_params() : 0) + (q_ ? q_->num_params() : 0) +
+           (passthrough_ ? passthrough_->num_params() : 0);
   }
 
  private:

@@ -317,6 +317,37 @@ TEST(ActorLoop, AppliesPublishedWeightsAndActsWithThem) {
   }
 }
 
+// exploration.uniform_random_params = false: random steps play the network's parameters, so the
+// actor takes no step before it has weights, and then every random step stores them.
+TEST(ActorLoop, RandomStepsKeepThePoliciesParametersAndWaitForThem) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  ActorLoopConfig config = test_loop_config();
+  config.exploration.epsilon_start = 1.0;  // every step random
+  config.exploration.epsilon_end = 1.0;
+  config.exploration.uniform_random_params = false;
+  ActorRunner actor(ctx, learner.join_endpoint(), config);
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return !learner.joins.empty(); }));
+  const auto waited_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  serve_until(learner, {&shard}, [&] { return std::chrono::steady_clock::now() >= waited_until; });
+  EXPECT_EQ(actor.counters.env_steps.load(), 0) << "it stepped before it had the network's parameters";
+
+  const std::vector<float> out{0.5F, -0.5F, 0.25F};
+  ASSERT_TRUE(
+      publish_until_applied(learner, {&shard}, actor, weights_message(1, 100, 0, constant_output_params(out)), 1));
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 3; }));
+  bool scores_vary = false;
+  for (const BatchCopy& b : shard.batches) {
+    for (uint32_t r = 0; r < b.count; ++r) {
+      ASSERT_EQ(b.actions[r * kWidth + 2], out[2]) << "a random step drew its parameter";
+      scores_vary = scores_vary || b.actions[r * kWidth] != out[0];
+    }
+  }
+  EXPECT_TRUE(scores_vary) << "the scores were not drawn";
+}
+
 TEST(ActorLoop, DropsAndCountsMalformedMessagesAndKeepsActing) {
   net::Context ctx;
   FakeLearner learner(ctx);
