@@ -39,6 +39,13 @@ StepResult ScaledParametersEnv::step(const ParamAction& action, std::span<float>
   return inner_->step({action.id, std::span<const float>(params_.data(), n)}, obs);
 }
 
+std::unique_ptr<Env> scaled_if(bool scaled, std::unique_ptr<Env> env) {
+  if (scaled) {
+    return std::make_unique<ScaledParametersEnv>(std::move(env));
+  }
+  return env;
+}
+
 ParameterPrior prior_in_units_of(const ParameterPrior& scaled, const ActionSpace& space) {
   assert(scaled.bias.size() == space.params.size());
   ParameterPrior p = scaled;

@@ -42,6 +42,9 @@ class ScaledParametersEnv final : public Env {
   std::vector<float> params_;  // the inner env's units, for one step
 };
 
+// `env` itself, or wrapped in a ScaledParametersEnv when `scaled` (env.scaled_parameters).
+std::unique_ptr<Env> scaled_if(bool scaled, std::unique_ptr<Env> env);
+
 // `space`'s parameters over [-1, 1] (the action space ScaledParametersEnv shows).
 ActionSpace scaled_action_space(const ActionSpace& space);
 

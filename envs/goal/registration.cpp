@@ -35,12 +35,9 @@ void register_goal_env(EnvRegistry& registry) {
   // Declared as the hfo env declares it (EnvRegistry::add checks): acceleration noise on or off.
   // env.scaled_parameters, as platform declares it: every parameter over [-1, 1], as MP-DQN plays it.
   r.keys = {EnvKey::boolean("noise", true), EnvKey::boolean("scaled_parameters", false)};
-  r.make = [](const EnvParams& p) -> std::unique_ptr<Env> {
-    auto env = std::make_unique<goal::GoalEnv>(goal::GoalConfig{.noise = p.boolean("noise")});
-    if (p.boolean("scaled_parameters")) {
-      return std::make_unique<ScaledParametersEnv>(std::move(env));
-    }
-    return env;
+  r.make = [](const EnvParams& p) {
+    return scaled_if(p.boolean("scaled_parameters"),
+                     std::make_unique<goal::GoalEnv>(goal::GoalConfig{.noise = p.boolean("noise")}));
   };
   r.observation_size = [](const EnvParams&) { return goal::GoalEnv::kObservationSize; };
   r.observation_bound = goal::GoalEnv::kObservationBound;

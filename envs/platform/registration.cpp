@@ -15,12 +15,10 @@ void register_platform_env(EnvRegistry& registry) {
   // env.noise, as the embedded HFO reads it: false removes the player's and enemies' noise.
   // env.scaled_parameters, as goal declares it: every parameter over [-1, 1], as MP-DQN plays it.
   r.keys = {EnvKey::boolean("noise", true), EnvKey::boolean("scaled_parameters", false)};
-  r.make = [](const EnvParams& params) -> std::unique_ptr<Env> {
-    auto env = std::make_unique<platform::PlatformEnv>(platform::PlatformConfig{.noise = params.boolean("noise")});
-    if (params.boolean("scaled_parameters")) {
-      return std::make_unique<ScaledParametersEnv>(std::move(env));
-    }
-    return env;
+  r.make = [](const EnvParams& params) {
+    return scaled_if(
+        params.boolean("scaled_parameters"),
+        std::make_unique<platform::PlatformEnv>(platform::PlatformConfig{.noise = params.boolean("noise")}));
   };
   r.observation_size = [](const EnvParams&) { return platform::PlatformEnv::kObservationSize; };
   r.observation_bound = 1.0F;
