@@ -15,6 +15,7 @@
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/platform/platform_env.hpp"
+#include "envs/scaled_parameters.hpp"
 #include "envs/toy/reach_stop.hpp"
 
 using pamdp::testing::alloc::CountAllocations;
@@ -119,6 +120,12 @@ TEST(GoalEnvAllocations, StepAndResetAllocateNothing) {
 // Platform: every tick of a decision, noise included, runs inside step().
 TEST(PlatformEnvAllocations, StepAndResetAllocateNothing) {
   platform::PlatformEnv env;
+  expect_env_allocation_free(env, 200, 200);
+}
+
+// Parameters over [-1, 1] (env.scaled_parameters): the mapping reuses one buffer.
+TEST(ScaledParametersAllocations, StepAndResetAllocateNothing) {
+  ScaledParametersEnv env(std::make_unique<goal::GoalEnv>());
   expect_env_allocation_free(env, 200, 200);
 }
 

@@ -26,6 +26,7 @@
 #include "core/rng.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/pdqn.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define PAMDP_COUNT_MALLOC 0
@@ -215,6 +216,45 @@ TEST(OptimAllocations, StepClipAndSoftUpdateAllocateNothing) {
     allocations = scope.count();
   }
   EXPECT_EQ(allocations, 0);
+}
+
+// P-DQN and MP-DQN: update() and act() allocate nothing, with HFO's Tackle masked (MP-DQN skips
+// its pass) and with the pass-through layer.
+TEST(PdqnAllocations, UpdateAndActAllocateNothing) {
+  if (!kCounting) {
+    GTEST_SKIP() << "AddressSanitizer owns malloc";
+  }
+  const ActionSpace& space = hfo::hfo_action_space();
+  const int obs = bench::RandomHfoBatch::kObs;
+  const ParameterPrior prior{obs, std::vector<float>(static_cast<size_t>(obs * space.num_params()), 0.01F),
+                             std::vector<float>(static_cast<size_t>(space.num_params()), 0.5F)};
+  for (const bool multipass : {false, true}) {
+    for (const bool passthrough : {false, true}) {
+      DdpgConfig c;
+      c.hidden = {64, 32};
+      c.mc_mix = 0.5;
+      PdqnSettings settings;
+      settings.passthrough = passthrough;
+      settings.reward_scale = 0.02;
+      Pdqn p(obs, space, c, 3, multipass, {hfo::kTackle}, settings, &prior);
+      const bench::RandomHfoBatch data(c.batch_size, 4);
+      const BatchView batch = data.view();
+      std::vector<float> out(static_cast<size_t>(p.output_width()));
+      p.update(batch);
+      p.act({batch.states.data(), static_cast<size_t>(obs)}, out);
+      long allocations = 0;
+      {
+        CountAllocations scope;
+        for (int i = 0; i < 3; ++i) {
+          p.update(batch);
+          p.act({batch.states.data(), static_cast<size_t>(obs)}, out);
+        }
+        allocations = scope.count();
+      }
+      EXPECT_EQ(allocations, 0) << (multipass ? "mpdqn" : "pdqn")
+                                << (passthrough ? " with the pass-through layer" : "");
+    }
+  }
 }
 
 TEST(DdpgAllocations, UpdateAllocatesNothing) {
