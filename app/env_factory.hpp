@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -48,6 +49,20 @@ inline std::string algorithm_help_footer() {
   std::string out = "Learners (train.algorithm):";
   for (const AlgorithmRegistration& r : algorithm_registry().all()) {
     out += "\n  " + r.name + std::string(r.name.size() < 12 ? 12 - r.name.size() : 1, ' ') + r.description;
+  }
+  // Each own key once, with its default (keys shared by learners are declared alike).
+  std::string keys;
+  for (const AlgorithmKey& k : algorithm_registry().keys()) {
+    std::ostringstream value;
+    if (k.is_boolean()) {
+      value << (std::get<bool>(k.default_value) ? "true" : "false");
+    } else {
+      value << std::get<double>(k.default_value);
+    }
+    keys += "\n  " + k.name + " = " + value.str() + ": " + k.help;
+  }
+  if (!keys.empty()) {
+    out += "\nTheir own keys (defaults):" + keys;
   }
   return out;
 }

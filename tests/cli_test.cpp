@@ -117,6 +117,20 @@ TEST(Cli, HelpListsSubcommands) {
   EXPECT_NE(sim.output.find("trace"), std::string::npos) << sim.output;
 }
 
+// The commands that train list the registered learners and every learner's own keys.
+TEST(Cli, TrainHelpListsTheLearnersAndTheirKeys) {
+  for (const std::string command : {"train", "learner"}) {
+    const RunResult r = run_pamdp(command + " --help");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    for (const pamdp::AlgorithmRegistration& a : pamdp::algorithm_registry().all()) {
+      EXPECT_NE(r.output.find("  " + a.name + " "), std::string::npos) << command << ": " << a.name;
+    }
+    for (const pamdp::AlgorithmKey& k : pamdp::algorithm_registry().keys()) {
+      EXPECT_NE(r.output.find("  " + k.name + " = "), std::string::npos) << command << ": " << k.name;
+    }
+  }
+}
+
 TEST(Cli, NoSubcommandFails) {
   const RunResult r = run_pamdp("");
   EXPECT_NE(r.exit_code, 0) << r.output;
