@@ -21,7 +21,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr int64_t kMaxWeightsBytes = int64_t{64} << 20;  // 16M parameters
-constexpr int64_t kMaxShardMessageBytes = 64 << 10;      // shards send actors nothing
+constexpr int64_t kMaxShardMessageBytes = 64 << 10;      // shards send actors InsertAcks only
 constexpr int kMaxLayerWidth = 1 << 16;
 // Control sockets (weights, learner answers) are looked at this often: often enough that new
 // weights apply within a millisecond, rarely enough that the poll syscalls cost nothing per step.
@@ -107,13 +107,51 @@ struct EnvSlot {
         seed(s) {}
 };
 
+// The sequences of the batches sent to one shard and not yet acknowledged, oldest first: a ring
+// of fixed capacity (cluster.actor_batches_in_flight), allocated when the shard is connected.
+class AckWindow {
+ public:
+  explicit AckWindow(int capacity) : seq_(static_cast<size_t>(capacity)) {}
+  [[nodiscard]] bool full() const { return count_ == seq_.size(); }
+  [[nodiscard]] bool empty() const { return count_ == 0; }
+  [[nodiscard]] size_t size() const { return count_; }
+  void push(uint64_t sequence) {
+    seq_[(head_ + count_) % seq_.size()] = sequence;
+    ++count_;
+  }
+  void pop_oldest() {
+    head_ = (head_ + 1) % seq_.size();
+    --count_;
+  }
+  void clear() { head_ = count_ = 0; }
+  // An InsertAck for `sequence` covers it and every earlier batch (one connection is in order).
+  // Returns how many batches it retired.
+  size_t acknowledge(uint64_t sequence) {
+    size_t n = 0;
+    while (count_ > 0 && seq_[head_] <= sequence) {
+      pop_oldest();
+      ++n;
+    }
+    return n;
+  }
+
+ private:
+  std::vector<uint64_t> seq_;
+  size_t head_ = 0;
+  size_t count_ = 0;
+};
+
 struct Shard {
   std::string endpoint;
   net::Socket dealer;
+  net::DisconnectWatch connection;  // a lost connection took the unacknowledged batches with it
+  AckWindow unacked;
+  Clock::time_point last_progress;                 // the last acknowledgement, or the send into an empty window
   std::optional<Clock::time_point> blocked_since;  // first failed send of the current stall
   std::optional<Clock::time_point> skipped_until;  // out of the rotation until then, then probed
 
-  Shard(net::Context& ctx, std::string ep) : endpoint(std::move(ep)), dealer(ctx, net::SocketType::kDealer) {}
+  Shard(net::Context& ctx, std::string ep, int window)
+      : endpoint(std::move(ep)), dealer(ctx, net::SocketType::kDealer), connection(ctx, dealer), unacked(window) {}
   [[nodiscard]] bool available(Clock::time_point now) const { return !skipped_until || now >= *skipped_until; }
 };
 
@@ -147,6 +185,9 @@ ActorLoopConfig checked(ActorLoopConfig c) {
   }
   if (c.exploration.demo_relabel && !(c.demo_table && c.make_teacher)) {
     throw std::invalid_argument("ActorLoop: exploration.demo_relabel needs the demonstration table and a teacher");
+  }
+  if (c.batches_in_flight < 1 || c.batches_in_flight > 1024) {
+    throw std::invalid_argument("ActorLoop: batches_in_flight must be within [1, 1024]");
   }
   if (c.heartbeat_ms < 1 || c.peer_timeout_ms < 1 || c.send_attempt_ms < 1 || c.tick_ms < 1 || c.shard_send_hwm < 1) {
     throw std::invalid_argument(
@@ -184,7 +225,10 @@ struct ActorLoop::Impl {
   void poll_learner(Clock::time_point now);
   void apply_map(const ClusterInfo& map);
   void heartbeat(Clock::time_point now);
-  void drain_shards();
+  void read_acks();
+  // Waits up to send_attempt_ms for an InsertAck (the shard in turn has a full window, or every
+  // shard is skipped).
+  void wait_for_acks();
   void heard_learner(Clock::time_point now);
   void update_epsilon();
   void note_malformed(const char* what);
@@ -206,6 +250,7 @@ struct ActorLoop::Impl {
   uint32_t num_actors_hint = 0;
   std::string weights_endpoint;
   std::vector<Shard> shards;
+  net::Poller shard_poller;  // every shard's DEALER, rebuilt with the map
   size_t next_shard = 0;
   net::Socket sub;
   std::array<net::Message, 2> weights_msg;  // newest valid one and the one being received
@@ -433,6 +478,13 @@ bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int
   if (s.skipped_until) {
     log::info("actor {}: shard {} accepts batches again", actor_index, s.endpoint);
   }
+  if (s.unacked.empty()) {
+    s.last_progress = Clock::now();
+  }
+  if (s.unacked.full()) {
+    s.unacked.pop_oldest();  // the final flush's send past the window
+  }
+  s.unacked.push(sequence);
   s.blocked_since.reset();
   s.skipped_until.reset();
   next_shard = (index + 1) % shards.size();
@@ -462,19 +514,43 @@ void ActorLoop::Impl::send_batch(OutgoingBatch& b, uint8_t table) {
     if (now >= next_control) {
       serve_control(now);
     }
+    read_acks();
     Shard* target = pick_shard(now);
     if (target == nullptr) {
-      // No shard in the map, or every one skipped: probe the skipped ones, then wait a slice.
+      if (shards.empty()) {
+        if (!waiting_for_shards_logged) {
+          log::warn("actor {}: no replay shard in the cluster map; holding the batch until one joins", actor_index);
+          waiting_for_shards_logged = true;
+        }
+        link.wait_readable(config.send_attempt_ms);
+        counters.send_blocked_ms.fetch_add(ms_between(now, Clock::now()), std::memory_order_relaxed);
+        continue;
+      }
+      // Every shard skipped or its window full: probe the skipped ones that have room, then wait
+      // for acknowledgements (backpressure: the shards' rate limiters hold them back).
       for (size_t j = 0; j < shards.size(); ++j) {
-        if (try_send((next_shard + j) % shards.size(), bytes, 0, b)) {
+        const size_t i = (next_shard + j) % shards.size();
+        if (!shards[i].unacked.full() && try_send(i, bytes, 0, b)) {
           return;
         }
       }
-      if (shards.empty() && !waiting_for_shards_logged) {
-        log::warn("actor {}: no replay shard in the cluster map; holding the batch until one joins", actor_index);
-        waiting_for_shards_logged = true;
+      wait_for_acks();
+      counters.send_blocked_ms.fetch_add(ms_between(now, Clock::now()), std::memory_order_relaxed);
+      continue;
+    }
+    if (target->unacked.full()) {
+      // Its turn, and its window is full: the shard's rate limiter holds inserts back. As with a
+      // full queue, a shard that answers nothing for a whole peer timeout while another could
+      // take the batch is skipped for a peer timeout.
+      if (ms_between(target->last_progress, now) >= config.peer_timeout_ms && another_available(next_shard, now)) {
+        log::info("actor {}: shard {} has acknowledged none of its {} batches for {} ms; sending to the others",
+                  actor_index, target->endpoint, target->unacked.size(), ms_between(target->last_progress, now));
+        target->skipped_until = now + std::chrono::milliseconds(config.peer_timeout_ms);
+        target->last_progress = now;
+        next_shard = (next_shard + 1) % shards.size();
+        continue;
       }
-      link.wait_readable(config.send_attempt_ms);
+      wait_for_acks();
       counters.send_blocked_ms.fetch_add(ms_between(now, Clock::now()), std::memory_order_relaxed);
       continue;
     }
@@ -504,6 +580,37 @@ void ActorLoop::Impl::send_batch(OutgoingBatch& b, uint8_t table) {
     }
   }
   b.clear();
+}
+
+void ActorLoop::Impl::wait_for_acks() {
+  if (shard_poller.poll(config.send_attempt_ms) > 0) {
+    read_acks();
+  }
+}
+
+void ActorLoop::Impl::read_acks() {
+  for (Shard& s : shards) {
+    if (s.connection.take() > 0 && !s.unacked.empty()) {
+      // The shard's end of the connection died (killed, or restarted on the same endpoint): what
+      // it had not acknowledged is gone, and it will not be acknowledged.
+      log::warn("actor {}: lost the connection to shard {}; its {} unacknowledged batches are lost", actor_index,
+                s.endpoint, s.unacked.size());
+      counters.batches_lost.fetch_add(static_cast<int64_t>(s.unacked.size()), std::memory_order_relaxed);
+      s.unacked.clear();
+    }
+    for (int n = 0; n < kMaxMessagesPerLook && s.dealer.recv(junk, 0); ++n) {
+      const wire::Envelope* env = wire::open_envelope(junk.bytes());
+      if (env == nullptr || env->payload_type() != wire::Payload::InsertAck) {
+        note_malformed("a shard sent something other than an InsertAck");
+        continue;
+      }
+      const size_t retired = s.unacked.acknowledge(env->payload_as_InsertAck()->sequence());
+      if (retired > 0) {
+        s.last_progress = Clock::now();
+        counters.batches_acknowledged.fetch_add(static_cast<int64_t>(retired), std::memory_order_relaxed);
+      }
+    }
+  }
 }
 
 void ActorLoop::Impl::final_flush() {
@@ -733,11 +840,9 @@ void ActorLoop::Impl::apply_map(const ClusterInfo& map) {
       continue;
     }
     try {
-      Shard s(ctx, ep);
-      s.dealer.set_send_hwm(config.shard_send_hwm);
-      // Keep the kernel from buffering megabytes of transitions behind the high water mark:
-      // backpressure from a rate-limited shard should reach the env loop within a few batches.
-      s.dealer.set_kernel_buffers(1 << 16, 1 << 16);
+      Shard s(ctx, ep, config.batches_in_flight);
+      // The window bounds what is in flight; the queue only needs to hold it.
+      s.dealer.set_send_hwm(std::max(config.shard_send_hwm, config.batches_in_flight));
       s.dealer.set_max_message_bytes(kMaxShardMessageBytes);
       if (config.curve) {
         s.dealer.make_curve_client(*config.curve);
@@ -756,6 +861,10 @@ void ActorLoop::Impl::apply_map(const ClusterInfo& map) {
     }
   }
   shards = std::move(next);
+  shard_poller.clear();
+  for (Shard& s : shards) {
+    shard_poller.add(s.dealer);
+  }
   if (!shards.empty()) {
     next_shard = had_shards ? next_shard % shards.size() : actor_index % shards.size();
     waiting_for_shards_logged = false;
@@ -772,19 +881,11 @@ void ActorLoop::Impl::heartbeat(Clock::time_point now) {
                                  counters.malformed_messages.load(std::memory_order_relaxed),
                                  counters.send_blocked_ms.load(std::memory_order_relaxed)};
   link.send_heartbeat(map_version, c);
-  drain_shards();
+  read_acks();
   if (!learner_silent && ms_between(learner_heard, now) > config.peer_timeout_ms) {
     log::warn("actor {}: no answer from the learner for {} ms; acting on with weights version {}", actor_index,
               ms_between(learner_heard, now), weights_version);
     learner_silent = true;
-  }
-}
-
-void ActorLoop::Impl::drain_shards() {
-  for (Shard& s : shards) {
-    for (int n = 0; n < kMaxMessagesPerLook && s.dealer.recv(junk, 0); ++n) {
-      note_malformed("a shard sent something to an actor");
-    }
   }
 }
 

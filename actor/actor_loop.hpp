@@ -12,10 +12,17 @@
 // ε: 1 until the first PolicyWeights arrive; then linear_epsilon(weights.updates, …) or, with
 // apex_epsilon, apex_epsilon(actor_index, max(num_actors_hint, actor_index + 1), base, alpha).
 //
-// Sending: batches go to the shards round robin, starting at actor_index % shards. A shard whose
-// queue is full holds the env loop (backpressure: waits in send_attempt_ms slices, answering
-// weights and heartbeats in between, counted in send_blocked_ms). A shard that takes nothing for
-// peer_timeout_ms while another shard is available is skipped for peer_timeout_ms, then probed.
+// Sending: batches go to the shards round robin, starting at actor_index % shards. Each shard
+// answers every batch it reads with an InsertAck, and reads none while its rate limiter holds
+// inserts back; an actor keeps at most batches_in_flight batches unacknowledged per shard
+// (credit-based flow control, as Reverb's writers' max_in_flight_items). A shard whose window
+// (or queue) is full holds the env loop (backpressure: waits in send_attempt_ms slices, answering
+// weights and heartbeats in between, counted in send_blocked_ms). So what is in flight, and how
+// stale the policy behind it, is bounded by actors x shards x batches_in_flight batches, whatever
+// the sockets buffer. A lost connection to a shard (killed, or restarted on the same endpoint)
+// empties its window: those batches are gone (batches_lost). A shard that acknowledges nothing,
+// or whose queue takes nothing, for peer_timeout_ms while another is available is skipped for
+// peer_timeout_ms, then probed.
 // With no shard in the map the loop waits for a map that has one. EpisodeReports and heartbeats
 // never block: one the join socket will not queue is dropped (reports_dropped).
 // Re-joins keep the actor index of the first join (it seeds the streams, picks the Ape-X ε and
@@ -55,10 +62,11 @@ struct ActorLoopConfig {
   bool apex_epsilon = false;  // per-actor fixed ε instead of the learner's linear schedule
   double apex_base = 0.4;
   double apex_alpha = 7.0;
-  uint64_t seed = 1;         // mixed with the actor index: actors explore differently
-  int shard_send_hwm = 8;    // batches queued per shard before sends block
-  int send_attempt_ms = 20;  // one blocking send attempt; control sockets are served in between
-  int tick_ms = 1000;        // on_tick period
+  uint64_t seed = 1;          // mixed with the actor index: actors explore differently
+  int batches_in_flight = 2;  // unacknowledged batches per shard (cluster.actor_batches_in_flight)
+  int shard_send_hwm = 8;     // batches queued per shard before sends block (at least batches_in_flight)
+  int send_attempt_ms = 20;   // one blocking send attempt; control sockets are served in between
+  int tick_ms = 1000;         // on_tick period
   std::optional<net::CurveClientKeys> curve;
   // With exploration.demo_fraction > 0: makes the teacher that plays the demonstrations, one per
   // env. An episode is a demonstration with probability demo_share(updates, demo_fraction,
@@ -82,8 +90,10 @@ struct ActorCounters {
   std::atomic<int64_t> weights_version{0};  // 0 = no weights yet (acting with ε = 1)
   std::atomic<int64_t> malformed_messages{0};
   std::atomic<int64_t> send_blocked_ms{0};
-  std::atomic<int64_t> reports_dropped{0};  // EpisodeReports the join socket would not take
-  std::atomic<double> epsilon{1.0};         // ε the next step uses
+  std::atomic<int64_t> batches_acknowledged{0};  // InsertAcks' worth: batches the shards have read
+  std::atomic<int64_t> batches_lost{0};          // unacknowledged when their shard's connection died
+  std::atomic<int64_t> reports_dropped{0};       // EpisodeReports the join socket would not take
+  std::atomic<double> epsilon{1.0};              // ε the next step uses
   // Learner updates between the weights this actor acts with and the newest update count it has
   // heard of (heartbeat answers, weights); 0 before the first weights.
   std::atomic<int64_t> weights_age_updates{0};

@@ -120,6 +120,7 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.exploration = resolve_exploration(config, envs.front()->action_space());
   loop_config.gamma = config.ddpg.gamma;
   loop_config.batch_transitions = config.cluster.actor_batch_transitions;
+  loop_config.batches_in_flight = config.cluster.actor_batches_in_flight;
   loop_config.heartbeat_ms = config.cluster.heartbeat_ms;
   loop_config.peer_timeout_ms = config.cluster.peer_timeout_ms;
   loop_config.apex_epsilon = o.apex_epsilon;

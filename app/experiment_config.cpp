@@ -124,6 +124,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.text("cluster.advertise_host", c.cluster.advertise_host);
   v.integer("cluster.publish_every_updates", c.cluster.publish_every_updates, 1, INT64_MAX);
   v.integer("cluster.actor_batch_transitions", c.cluster.actor_batch_transitions, 1, 65536);
+  v.integer("cluster.actor_batches_in_flight", c.cluster.actor_batches_in_flight, 1, 1024);
   v.real("cluster.samples_per_insert", c.cluster.samples_per_insert, 0.0, 1e6);
   v.integer("cluster.rate_limit_slack", c.cluster.rate_limit_slack, 1, INT64_MAX);
   v.integer("cluster.requests_in_flight_per_shard", c.cluster.requests_in_flight_per_shard, 1, 64);

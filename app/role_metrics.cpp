@@ -142,6 +142,10 @@ ActorMetrics::ActorMetrics(Registry& r, const ActorCounters& c, const Env& env) 
   Counter* batches = &r.counter("pamdp_actor_batches_sent_total", "TransitionBatch messages sent to replay shards");
   Counter* blocked = &r.counter("pamdp_actor_send_blocked_seconds_total",
                                 "Time the env loop waited for a shard to take a batch (backpressure)");
+  Counter* acked = &r.counter("pamdp_actor_batches_acknowledged_total",
+                              "TransitionBatches the replay shards have acknowledged (read)");
+  Counter* lost = &r.counter("pamdp_actor_batches_lost_total",
+                             "TransitionBatches unacknowledged when the connection to their shard died");
   Counter* dropped =
       &r.counter("pamdp_actor_reports_dropped_total", "Episode reports the learner's socket would not take");
   Counter* bad = &r.counter("pamdp_bad_messages_total", "Received messages dropped as malformed");
@@ -156,6 +160,8 @@ ActorMetrics::ActorMetrics(Registry& r, const ActorCounters& c, const Env& env) 
     transitions->set(c.transitions_sent.load(rl));
     batches->set(c.batches_sent.load(rl));
     blocked->set(c.send_blocked_ms.load(rl) / 1000);
+    acked->set(c.batches_acknowledged.load(rl));
+    lost->set(c.batches_lost.load(rl));
     dropped->set(c.reports_dropped.load(rl));
     bad->set(c.malformed_messages.load(rl));
     version->set(static_cast<double>(c.weights_version.load(rl)));
@@ -174,6 +180,8 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
                                 "Sampled transitions in replies that could not be queued to the learner");
   Counter* replies_dropped =
       &r.counter("pamdp_replay_sample_replies_dropped_total", "Sample replies that could not be queued to the learner");
+  Counter* acks_dropped = &r.counter("pamdp_replay_insert_acks_dropped_total",
+                                     "Insert acknowledgements that could not be queued to an actor");
   Counter* bad = &r.counter("pamdp_bad_messages_total", "Received messages dropped as malformed");
   Counter* refused = &r.counter("pamdp_connections_refused_total", kRefusedHelp);
   Counter* waits = &r.counter("pamdp_replay_rate_limiter_insert_wait_seconds_total",
@@ -192,6 +200,7 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
     sampled->set(c.sampled);
     dropped->set(c.transitions_dropped);
     replies_dropped->set(c.replies_dropped);
+    acks_dropped->set(c.acks_dropped);
     bad->set(c.malformed);
     refused->set(c.connections_refused);
     waits->set(c.insert_blocked_ms / 1000);

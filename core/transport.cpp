@@ -16,6 +16,7 @@
 #include <map>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
 #include <zmq.hpp>
 
@@ -437,6 +438,45 @@ HandshakeMonitor::~HandshakeMonitor() {
 
 int64_t HandshakeMonitor::refused() const {
   return impl_->refused.load();
+}
+
+DisconnectWatch::DisconnectWatch(Context& ctx, Socket& socket) : watched_(socket.raw()) {
+  static std::atomic<uint64_t> next_id{0};
+  const std::string endpoint = "inproc://pamdp-disconnect-watch-" + std::to_string(next_id.fetch_add(1));
+  pair_ = zmq_socket(ctx.raw(), ZMQ_PAIR);
+  if (pair_ == nullptr || zmq_socket_monitor(watched_, endpoint.c_str(), ZMQ_EVENT_DISCONNECTED) != 0 ||
+      zmq_connect(pair_, endpoint.c_str()) != 0) {
+    const std::string error = zmq_strerror(zmq_errno());
+    if (pair_ != nullptr) {
+      zmq_socket_monitor(watched_, nullptr, 0);
+      zmq_close(pair_);
+    }
+    throw std::runtime_error("cannot watch a socket's connections: " + error);
+  }
+}
+
+DisconnectWatch::DisconnectWatch(DisconnectWatch&& other) noexcept
+    : watched_(std::exchange(other.watched_, nullptr)), pair_(std::exchange(other.pair_, nullptr)) {}
+
+DisconnectWatch::~DisconnectWatch() {
+  if (pair_ != nullptr) {
+    zmq_socket_monitor(watched_, nullptr, 0);
+    zmq_close(pair_);
+  }
+}
+
+int DisconnectWatch::take() {
+  int n = 0;
+  zmq_msg_t frame;
+  zmq_msg_init(&frame);
+  // An event is two frames: 2 bytes event id + 4 bytes value, then the endpoint.
+  while (zmq_msg_recv(&frame, pair_, ZMQ_DONTWAIT) >= 0) {
+    if (zmq_msg_more(&frame) == 0) {
+      ++n;  // the event's last frame
+    }
+  }
+  zmq_msg_close(&frame);
+  return n;
 }
 
 void Poller::add(Socket& s) {

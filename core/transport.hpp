@@ -144,6 +144,27 @@ class HandshakeMonitor {
   std::unique_ptr<Impl> impl_;
 };
 
+// Counts the connections a socket has lost (libzmq's socket monitor, ZMQ_EVENT_DISCONNECTED), read
+// without a thread: take() drains the events queued so far and never blocks. An actor uses it to
+// learn that the batches in flight to a shard died with its connection. Construct after the
+// socket; destroy before it (a Socket's moves keep the watch valid). Throws std::runtime_error if
+// the monitor cannot be set up.
+class DisconnectWatch {
+ public:
+  DisconnectWatch(Context& ctx, Socket& socket);
+  ~DisconnectWatch();
+  DisconnectWatch(DisconnectWatch&& other) noexcept;
+  DisconnectWatch& operator=(DisconnectWatch&&) = delete;
+  DisconnectWatch(const DisconnectWatch&) = delete;
+  DisconnectWatch& operator=(const DisconnectWatch&) = delete;
+  // Disconnects since the last call.
+  int take();
+
+ private:
+  void* watched_ = nullptr;
+  void* pair_ = nullptr;
+};
+
 // Waits on several sockets at once; returns the indices of the readable ones.
 class Poller {
  public:

@@ -193,6 +193,11 @@ void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::
   finish(fbb, Payload::Heartbeat, CreateHeartbeat(fbb, role, n, map_version, c).Union());
 }
 
+void build_insert_ack(flatbuffers::FlatBufferBuilder& fbb, uint64_t sequence, uint32_t inserted) {
+  fbb.Clear();
+  finish(fbb, Payload::InsertAck, CreateInsertAck(fbb, sequence, inserted).Union());
+}
+
 void build_metrics_urls_request(flatbuffers::FlatBufferBuilder& fbb) {
   fbb.Clear();
   finish(fbb, Payload::MetricsUrlsRequest, CreateMetricsUrlsRequest(fbb).Union());

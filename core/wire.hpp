@@ -76,6 +76,8 @@ void build_episode_report(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id
                           uint32_t steps, int32_t status, uint64_t policy_version, bool scripted = false);
 void build_heartbeat(flatbuffers::FlatBufferBuilder& fbb, Role role, const std::string& name, uint64_t map_version,
                      std::span<const int64_t> counters);
+// Shard -> actor: the batch `sequence` was read, and `inserted` of its transitions stored.
+void build_insert_ack(flatbuffers::FlatBufferBuilder& fbb, uint64_t sequence, uint32_t inserted);
 void build_metrics_urls_request(flatbuffers::FlatBufferBuilder& fbb);
 void build_metrics_urls(flatbuffers::FlatBufferBuilder& fbb, const std::vector<std::string>& urls);
 

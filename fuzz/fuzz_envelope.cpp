@@ -138,6 +138,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     case Payload::MetricsUrlsRequest: break;
     case Payload::MetricsUrls: touch_strings(env->payload_as_MetricsUrls()->urls()); break;
+    case Payload::InsertAck: {
+      const InsertAck* a = env->payload_as_InsertAck();
+      g_sink = g_sink + a->sequence() + a->inserted();
+      break;
+    }
     default: break;
   }
   return 0;

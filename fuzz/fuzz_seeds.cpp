@@ -78,6 +78,8 @@ int main(int argc, char** argv) {
   write(env_dir / "metrics_urls_request", fbb);
   wire::build_metrics_urls(fbb, {"http://127.0.0.1:9000/metrics", "http://127.0.0.1:9001/metrics"});
   write(env_dir / "metrics_urls", fbb);
+  wire::build_insert_ack(fbb, 42, 64);
+  write(env_dir / "insert_ack", fbb);
 
   // fuzz_transition_batch reads: obs, act (u8), count (u16), expect flags, max_count (u16), then
   // per-array length choices and floats. A consistent batch of 5 rows of widths 3/4:

@@ -243,6 +243,7 @@ ShardCounters ShardServer::counters() const {
   c.requests_waiting = waiting_now_.load(r);
   c.insert_blocked_ms = blocked_ms_.load(r);
   c.replies_dropped = replies_dropped_.load(r);
+  c.acks_dropped = acks_dropped_.load(r);
   c.size = size_.load(r);
   c.map_version = map_version_pub_.load(r);
   c.joins = joins_.load(r);
@@ -464,28 +465,42 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
       malformed(log_insert_, "insert", "not a TransitionBatch", now);
       continue;
     }
-    if (!wire::valid_batch(batch, obs, act, options_.max_batch_transitions)) {
-      malformed(log_insert_, "insert", "TransitionBatch with wrong widths, sizes, count or non-finite values", now);
-      continue;
+    // Every batch read is acknowledged, stored or not, so that its actor's window moves on.
+    acknowledge(batch->sequence(), insert_batch(*batch, obs, act, now));
+  }
+}
+
+uint32_t ShardServer::insert_batch(const wire::TransitionBatch& batch, uint32_t obs, uint32_t act,
+                                   Clock::time_point now) {
+  if (!wire::valid_batch(&batch, obs, act, options_.max_batch_transitions)) {
+    malformed(log_insert_, "insert", "TransitionBatch with wrong widths, sizes, count or non-finite values", now);
+    return 0;
+  }
+  if (batch.table() == wire::kDemoTable) {
+    if (!shard_->has_demo_table()) {
+      malformed(log_insert_, "insert",
+                "TransitionBatch for the demonstration table, and this run keeps none (ddpg.demo_bc_weight = 0)", now);
+      return 0;
     }
-    if (batch->table() == wire::kDemoTable) {
-      if (!shard_->has_demo_table()) {
-        malformed(log_insert_, "insert",
-                  "TransitionBatch for the demonstration table, and this run keeps none (ddpg.demo_bc_weight = 0)",
-                  now);
-        continue;
-      }
-      shard_->insert_demos(wire::rows_of(batch));
-      demo_inserted_.fetch_add(batch->count(), std::memory_order_relaxed);
-      continue;
-    }
-    if (batch->table() != wire::kReplayTable) {
-      malformed(log_insert_, "insert", "TransitionBatch for a table that does not exist", now);
-      continue;
-    }
-    shard_->insert(wire::rows_of(batch));
-    inserted_.fetch_add(batch->count(), std::memory_order_relaxed);
-    size_.store(shard_->buffer().size(), std::memory_order_relaxed);
+    shard_->insert_demos(wire::rows_of(&batch));
+    demo_inserted_.fetch_add(batch.count(), std::memory_order_relaxed);
+    return batch.count();
+  }
+  if (batch.table() != wire::kReplayTable) {
+    malformed(log_insert_, "insert", "TransitionBatch for a table that does not exist", now);
+    return 0;
+  }
+  shard_->insert(wire::rows_of(&batch));
+  inserted_.fetch_add(batch.count(), std::memory_order_relaxed);
+  size_.store(shard_->buffer().size(), std::memory_order_relaxed);
+  return batch.count();
+}
+
+void ShardServer::acknowledge(uint64_t sequence, uint32_t inserted) {
+  wire::build_insert_ack(ack_fbb_, sequence, inserted);
+  // A ROUTER drops what it cannot route or queue; the next acknowledgement covers this one.
+  if (!insert_.send_to(identity_.bytes(), wire::bytes_of(ack_fbb_), 0)) {
+    acks_dropped_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

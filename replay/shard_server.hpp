@@ -5,18 +5,18 @@
 // sample() copy floats and allocate nothing. Not thread-safe.
 //
 // ShardServer: one thread's event loop around a ReplayShard. It binds a ROUTER "insert"
-// (TransitionBatch from actors, no answer) and a ROUTER "sample" (SampleRequest from the
-// learner, SampleReply possibly later), and keeps a DEALER on the learner's join socket
-// (JoinRequest until a ClusterMap comes, then Heartbeat every heartbeat_ms; it joins again when
-// the learner answers with another map version or stays silent for peer_timeout_ms). The shard
-// itself is built from the first ClusterMap's config_toml through a caller-given function, so
-// this library knows nothing of TOML or experiment configs. A later map with another capacity
+// (TransitionBatch from actors, each answered with an InsertAck once read) and a ROUTER "sample" (SampleRequest from
+// the learner, SampleReply possibly later), and keeps a DEALER on the learner's join socket (JoinRequest until a
+// ClusterMap comes, then Heartbeat every heartbeat_ms; it joins again when the learner answers with another map version
+// or stays silent for peer_timeout_ms). The shard itself is built from the first ClusterMap's config_toml through a
+// caller-given function, so this library knows nothing of TOML or experiment configs. A later map with another capacity
 // or other widths rebuilds the shard (dropping its data); other rate settings apply at once,
 // with the limiter's counters kept.
 //   - Every received frame is verified (wire::open_envelope, payload type, wire::valid_batch);
 //     a bad one is dropped, counted (malformed) and logged at most once per second per kind.
 //   - Backpressure: while the rate limiter holds inserts back the insert socket is not read, so
-//     the actors' DEALER queues fill and their sends block. Sample requests that cannot be
+//     no InsertAck goes out and the actors, which keep at most a few batches unacknowledged
+//     per shard, stop sending and stepping. Sample requests that cannot be
 //     served yet wait in a FIFO queue of at most kMaxWaitingRequests; while it is full the
 //     sample socket is not read either.
 //   - Steady-state inserting and sampling allocate nothing (one reused FlatBufferBuilder, a
@@ -161,6 +161,7 @@ struct ShardCounters {
   int64_t map_version = 0;          // of the last ClusterMap; 0 before joining
   int64_t joins = 0;                // ClusterMaps taken (1 + re-joins)
   int64_t restored = 0;             // transitions restored from the snapshot at start
+  int64_t acks_dropped = 0;         // InsertAcks ZeroMQ could not queue (actor gone); later ones cover them
   int64_t connections_refused = 0;  // failed handshakes at the insert and sample sockets (no or wrong CURVE key)
 };
 
@@ -215,6 +216,10 @@ class ShardServer {
   void read_join_socket(Clock::time_point now);
   void take_cluster_map(const wire::ClusterMap& map, Clock::time_point now);
   void read_insert_socket(Clock::time_point now);
+  // Stores a verified batch in its table; returns the transitions stored (0: refused, counted).
+  uint32_t insert_batch(const wire::TransitionBatch& batch, uint32_t obs, uint32_t act, Clock::time_point now);
+  // Sends an InsertAck to the sender of the frame just read.
+  void acknowledge(uint64_t sequence, uint32_t inserted);
   void read_sample_socket(Clock::time_point now);
   void serve_waiting_requests(Clock::time_point now);
   void malformed(LogGate& gate, const char* socket, const char* why, Clock::time_point now);
@@ -234,6 +239,7 @@ class ShardServer {
 
   std::unique_ptr<ReplayShard> shard_;
   flatbuffers::FlatBufferBuilder fbb_{1 << 16};
+  flatbuffers::FlatBufferBuilder ack_fbb_{64};
   net::Message identity_;
   net::Message frame_;
   std::array<WaitingRequest, kMaxWaitingRequests> waiting_{};
@@ -259,7 +265,7 @@ class ShardServer {
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
       size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0},
-      restored_{0}, demo_inserted_{0};
+      restored_{0}, demo_inserted_{0}, acks_dropped_{0};
 };
 
 }  // namespace pamdp

@@ -1,8 +1,7 @@
 // Test doubles for the actor role: a fake learner (join ROUTER + weights PUB) and a fake replay
-// shard (insert ROUTER), both bound on tcp://127.0.0.1:* with the ports read back, and a runner
-// that joins and runs an ActorLoop on its own thread over ReachStop envs. Nothing sleeps: the
-// fakes wait on their sockets for a few milliseconds at a time until a condition holds or a
-// deadline passes.
+// shard (insert ROUTER, acknowledging every batch it reads), both bound on tcp://127.0.0.1:* with the ports read back,
+// and a runner that joins and runs an ActorLoop on its own thread over ReachStop envs. Nothing sleeps: the fakes wait
+// on their sockets for a few milliseconds at a time until a condition holds or a deadline passes.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -73,10 +72,12 @@ struct JoinCopy {
 
 class FakeShard {
  public:
-  explicit FakeShard(net::Context& ctx, int recv_hwm = 1000) : router_(ctx, net::SocketType::kRouter) {
+  // Binds `endpoint` (a restarted shard takes its predecessor's) or any free loopback port.
+  explicit FakeShard(net::Context& ctx, int recv_hwm = 1000, const std::string& endpoint = "tcp://127.0.0.1:*")
+      : router_(ctx, net::SocketType::kRouter) {
     router_.set_recv_hwm(recv_hwm);
-    router_.set_kernel_buffers(1 << 16, 1 << 16);  // as the real shard: backpressure within a few batches
-    endpoint_ = router_.bind("tcp://127.0.0.1:*");
+    router_.set_kernel_buffers(1 << 16, 1 << 16);
+    endpoint_ = router_.bind(endpoint);
   }
   [[nodiscard]] const std::string& endpoint() const { return endpoint_; }
 
@@ -91,6 +92,10 @@ class FakeShard {
       const wire::TransitionBatch* b = env != nullptr && env->payload_type() == wire::Payload::TransitionBatch
                                            ? env->payload_as_TransitionBatch()
                                            : nullptr;
+      if (b != nullptr && acking) {
+        wire::build_insert_ack(ack_fbb_, b->sequence(), wire::valid_batch(b, kObs, kWidth, 64) ? b->count() : 0);
+        router_.send_to(identity, wire::bytes_of(ack_fbb_), 0);
+      }
       if (b == nullptr || !wire::valid_batch(b, kObs, kWidth, 64)) {
         ++invalid;
         continue;
@@ -112,8 +117,14 @@ class FakeShard {
   }
 
   void send_to_actor(std::span<const uint8_t> bytes) { router_.send_to(identity, bytes, 100); }
+  // Acknowledges the batch `sequence` (and so every earlier one) by hand.
+  void ack(uint64_t sequence) {
+    wire::build_insert_ack(ack_fbb_, sequence, 0);
+    router_.send_to(identity, wire::bytes_of(ack_fbb_), 100);
+  }
 
   bool reading = true;
+  bool acking = true;  // answers every batch read with an InsertAck, as the real shard does
   std::vector<BatchCopy> batches;
   int invalid = 0;
   Bytes identity;  // the actor's DEALER, once it has sent something
@@ -122,6 +133,7 @@ class FakeShard {
   net::Socket router_;
   std::string endpoint_;
   net::Message identity_msg_, payload_;
+  flatbuffers::FlatBufferBuilder ack_fbb_{64};
 };
 
 class FakeLearner {

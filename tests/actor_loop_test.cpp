@@ -469,6 +469,50 @@ TEST(ActorLoop, BackpressureFromAFullShardHoldsTheEnvLoop) {
   EXPECT_EQ(shard.invalid, 0);
 }
 
+// Credit-based flow control: at most batches_in_flight batches unacknowledged per shard; an
+// acknowledgement frees its batch and every earlier one; a lost connection (the shard restarted
+// on the same endpoint) frees the batches that died with it.
+TEST(ActorLoop, KeepsAtMostItsWindowUnacknowledgedPerShard) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  auto shard = std::make_unique<FakeShard>(ctx);
+  shard->acking = false;
+  const std::string endpoint = shard->endpoint();
+  learner.shard_endpoints = {endpoint};
+  ActorLoopConfig config = test_loop_config();
+  config.batches_in_flight = 3;
+  ActorRunner actor(ctx, learner.join_endpoint(), config);
+
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return shard->batches.size() == 3; }));
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return actor.counters.send_blocked_ms.load() >= 100; }));
+  const int64_t steps = actor.counters.env_steps.load();
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return actor.counters.send_blocked_ms.load() >= 250; }));
+  EXPECT_EQ(shard->batches.size(), 3U) << "sent past its window";
+  EXPECT_EQ(actor.counters.env_steps.load(), steps) << "stepped with a full window";
+
+  shard->ack(shard->batches[1].sequence);  // frees the first two
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return shard->batches.size() == 5; }));
+  EXPECT_EQ(actor.counters.batches_acknowledged.load(), 2);
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return actor.counters.send_blocked_ms.load() >= 400; }));
+  EXPECT_EQ(shard->batches.size(), 5U) << "sent past its window";
+
+  // The shard restarts on the same endpoint (the learner's map does not change) and acknowledges
+  // what it reads: the three batches the old one held are lost, and sending goes on.
+  shard.reset();
+  for (int attempt = 0; shard == nullptr; ++attempt) {
+    try {
+      shard = std::make_unique<FakeShard>(ctx, 1000, endpoint);
+    } catch (const std::runtime_error&) {  // ZeroMQ frees the port on its I/O thread, soon after
+      ASSERT_LT(attempt, 200) << "the old shard's port stayed in use";
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  ASSERT_TRUE(serve_until(learner, {shard.get()}, [&] { return shard->batches.size() >= 50; }));
+  EXPECT_EQ(actor.counters.batches_lost.load(), 3);
+  EXPECT_GE(actor.counters.batches_acknowledged.load(), 2 + 50 - 3) << "the new shard acknowledged all but a window";
+  EXPECT_EQ(shard->invalid, 0);
+}
+
 TEST(ActorLoop, SkipsAShardThatIsGone) {
   net::Context ctx;
   FakeLearner learner(ctx);

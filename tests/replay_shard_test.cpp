@@ -482,9 +482,22 @@ class FakeActor {
   }
   void send_raw(std::span<const uint8_t> bytes) { ASSERT_TRUE(dealer_.send(bytes, 1000)); }
   net::Socket& socket() { return dealer_; }
+  // The next InsertAck as {sequence, inserted}, or nothing within timeout_ms.
+  std::optional<std::pair<uint64_t, uint32_t>> ack(int timeout_ms = kTimeoutMs) {
+    if (!dealer_.recv(frame_, timeout_ms)) {
+      return std::nullopt;
+    }
+    const wire::Envelope* env = wire::open_envelope(frame_.bytes());
+    if (env == nullptr || env->payload_type() != wire::Payload::InsertAck) {
+      ADD_FAILURE() << "not an InsertAck";
+      return std::nullopt;
+    }
+    return std::pair{env->payload_as_InsertAck()->sequence(), env->payload_as_InsertAck()->inserted()};
+  }
 
  private:
   net::Socket dealer_;
+  net::Message frame_;
   flatbuffers::FlatBufferBuilder fbb_;
 };
 
@@ -765,6 +778,40 @@ TEST(ShardServer, RateLimiterPacesSamplesAndInserts) {
   EXPECT_EQ(r->request_id(), 3U);
   EXPECT_EQ(counters().sampled, 31);
   EXPECT_EQ(counters().malformed, 0);
+}
+
+// Credit-based flow control: every batch read is acknowledged with its sequence and what was
+// stored of it (0 when refused), and none while the rate limiter holds inserts back.
+TEST(ShardServer, AcknowledgesEveryBatchItReadsAndNoneWhileInsertsAreHeld) {
+  using Ack = std::pair<uint64_t, uint32_t>;
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config(2.0, 10, 5)));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  FakeSampler sampler(ctx, shard.server().sample_endpoint());
+
+  actor.insert(make_rows(3, 0.0F), 5);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 3}}));
+  actor.insert(make_rows(2, 0.0F, kObs + 1), 6);  // wrong widths: refused, still acknowledged
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{6, 0}}));
+  actor.insert(make_rows(2, 0.0F), 7, wire::kDemoTable);  // no demonstration table in this run
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{7, 0}}));
+  EXPECT_EQ(shard.server().counters().malformed, 2);
+
+  // 18 inserts: 2 * (18 - 10) > 0 + 2 * 5, so the limiter holds the next batch back, unread.
+  actor.insert(make_rows(15, 3.0F), 8);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{8, 15}}));
+  actor.insert(make_rows(1, 18.0F), 9);
+  ASSERT_TRUE(eventually([&] { return shard.server().counters().insert_blocked_ms >= 50; }));
+  EXPECT_EQ(actor.ack(0), std::nullopt) << "acknowledged a batch the shard has not read";
+  EXPECT_EQ(shard.server().counters().inserted, 18);
+
+  sampler.request(1, 16);  // 16 <= 2 * 8 + 10; then 2 * 8 <= 16 + 10 admits inserts again
+  ASSERT_NE(sampler.reply(), nullptr);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{9, 1}}));
+  EXPECT_EQ(shard.server().counters().inserted, 19);
+  EXPECT_EQ(shard.server().counters().acks_dropped, 0);
 }
 
 TEST(ShardServer, WaitingRequestsAreServedInOrder) {

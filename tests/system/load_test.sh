@@ -11,7 +11,7 @@
 #      - backpressure is visible: the actors' pamdp_actor_send_blocked_seconds_total or the
 #        shards' pamdp_replay_rate_limiter_insert_wait_seconds_total grow;
 #      - nothing grows without bound: transitions sent by actors but not yet inserted by a shard
-#        stay below what the ZeroMQ high water marks and socket buffers allow, and the resident
+#        stay within the actors' windows of unacknowledged batches, and the resident
 #        memory of the learner and of each shard grows by less than --max-rss-growth-mb after the
 #        buffers filled;
 #      - every process is still alive.
@@ -47,10 +47,9 @@ test_name=load_test
 source "$src/tests/system/cluster_lib.sh"
 
 batch=64      # cluster.actor_batch_transitions
-send_hwm=8    # the actor's batches queued per shard (actor/actor_loop.hpp shard_send_hwm)
-recv_hwm=16   # the shard's batches queued per actor (replay/shard_server.hpp insert_recv_hwm)
+window=2      # unacknowledged batches per actor and shard (cluster.actor_batches_in_flight)
 ratio=32      # samples per insert: updates_per_step 1 (set here; fast.toml has 0.5) x batch_size 32
-common+=(--set train.updates_per_step=1 --set replay.capacity=20000 --set replay.warmup=1000 --set "cluster.actor_batch_transitions=$batch"
+common+=(--set train.updates_per_step=1 --set replay.capacity=20000 --set replay.warmup=1000 --set "cluster.actor_batch_transitions=$batch" --set "cluster.actor_batches_in_flight=$window"
   --set train.checkpoint_every_seconds=0)
 
 rss_kb() { awk '$1 == "VmRSS:" { print $2 }' "/proc/$1/status" 2>/dev/null || echo 0; }
@@ -75,11 +74,12 @@ read_counters() {  # $1: prefix (t1 / t2)
   local shard_urls=("${surl[@]}") actor_urls=("${aurl[@]}")
   c[$1_time]=$(date +%s.%N)
   c[$1_updates]=$(updates)
+  # Sent before inserted: sent(then) - inserted(now) can only under-state what is in flight now.
+  c[$1_sent]=$(sum_metric pamdp_actor_transitions_sent_total "${actor_urls[@]}")
   c[$1_inserted]=$(sum_metric pamdp_replay_transitions_inserted_total "${shard_urls[@]}")
   c[$1_dropped]=$(sum_metric pamdp_replay_sample_replies_dropped_total "${shard_urls[@]}")
   c[$1_sampled]=$(sum_metric pamdp_replay_transitions_sampled_total "${shard_urls[@]}")
   c[$1_limiter_wait]=$(sum_metric pamdp_replay_rate_limiter_insert_wait_seconds_total "${shard_urls[@]}")
-  c[$1_sent]=$(sum_metric pamdp_actor_transitions_sent_total "${actor_urls[@]}")
   c[$1_blocked]=$(sum_metric pamdp_actor_send_blocked_seconds_total "${actor_urls[@]}")
   c[$1_env_steps]=$(sum_metric pamdp_env_steps_total "${actor_urls[@]}")
 }
@@ -151,10 +151,9 @@ inserted=$(diff_of inserted)
 sampled=$(diff_of sampled)
 replay_ratio=$(calc "$sampled / ($inserted > 0 ? $inserted : 1)")
 in_flight=$(calc "${c[t2_sent]} - ${c[t2_inserted]}")
-# Per actor and shard: the actor's send high water mark, the shard's receive high water mark and
-# the two kernel socket buffers (64 KiB each, doubled by Linux) in batches.
-batch_bytes=$(((58 * 2 + 10 + 3) * 4 * batch))
-in_flight_bound=$((actors * 2 * (send_hwm + recv_hwm + 4 * 65536 / batch_bytes + 1) * batch))
+# Per actor and shard: its window of unacknowledged batches (InsertAck, docs/protocol.md). Before
+# the window, the ZeroMQ high water marks and kernel buffers bounded it: 131,072 here.
+in_flight_bound=$((actors * 2 * window * batch))
 blocked=$(diff_of blocked)
 limiter_wait=$(diff_of limiter_wait)
 env_rate=$(calc "$(diff_of env_steps) / $elapsed")
@@ -177,7 +176,7 @@ awk -v r="$replay_ratio" -v t="$ratio" 'BEGIN { exit !(r >= 0.75 * t && r <= 1.2
 awk -v b="$blocked" -v w="$limiter_wait" 'BEGIN { exit !(b + w > 0) }' ||
   fail "no backpressure visible: actors blocked $blocked s, shards held inserts $limiter_wait s"
 awk -v f="$in_flight" -v b="$in_flight_bound" 'BEGIN { exit !(f <= b) }' ||
-  fail "$in_flight transitions sent but not yet inserted: more than the high water marks allow ($in_flight_bound)"
+  fail "$in_flight transitions sent but not yet inserted: more than the actors' windows allow ($in_flight_bound)"
 for p in learner shard0 shard1; do
   awk -v g="$(growth_mb "$p")" -v m="$max_rss_growth_mb" 'BEGIN { exit !(g <= m) }' ||
     fail "$p grew by $(growth_mb "$p") MB of resident memory in ${elapsed} s (limit $max_rss_growth_mb MB)"
