@@ -1,7 +1,11 @@
 // One replay shard (replay/shard_server.hpp) on its own thread behind real loopback TCP
 // sockets, with the HFO widths (obs 58, action 10) and a fake learner that answers the join.
 // BM_ReplayInsertTcp/64: an actor's DEALER sends TransitionBatches of 64 transitions as fast as
-//   the shard stores them (verify, validate, copy into the ring); items = transitions stored.
+//   the shard stores them (verify, validate, copy into the ring, InsertAck); items = transitions
+//   stored. Up to 32 batches in flight: the data path's own rate, the reference.
+// BM_ReplayInsertTcpAcked/64/W: the same, paced as an actor paces its sends to one shard: at most
+//   W batches unacknowledged (cluster.actor_batches_in_flight), the next sent as soon as an
+//   InsertAck frees one. Its ratio to BM_ReplayInsertTcp/64 is what the window costs one actor.
 // BM_ReplaySampleTcp/N: the learner's DEALER keeps N SampleRequests of 32 in flight and
 //   verifies every reply (open_envelope) before sending the next; items = transitions received.
 // The rate limiter is configured out of the way (huge slack): these measure the data path.
@@ -109,6 +113,7 @@ void BM_ReplayInsertTcp(benchmark::State& state) {
   const std::vector<uint8_t> message = hfo_batch(batch);
   constexpr int kRound = 16;  // batches per iteration
   int64_t sent = 0;
+  net::Message ack;
   for (auto _ : state) {
     for (int i = 0; i < kRound; ++i) {
       actor.send(message, -1);
@@ -116,6 +121,8 @@ void BM_ReplayInsertTcp(benchmark::State& state) {
     sent += int64_t{kRound} * batch;
     // At most two rounds in flight, so the untimed tail below is small.
     shard.wait_inserted(sent - 2 * int64_t{kRound} * batch);
+    while (actor.recv(ack, 0)) {
+    }
   }
   shard.wait_inserted(sent);
   state.SetItemsProcessed(sent);
@@ -123,6 +130,39 @@ void BM_ReplayInsertTcp(benchmark::State& state) {
   state.counters["malformed"] = static_cast<double>(shard.server().counters().malformed);
 }
 BENCHMARK(BM_ReplayInsertTcp)->Arg(64)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+void BM_ReplayInsertTcpAcked(benchmark::State& state) {
+  const auto batch = static_cast<uint32_t>(state.range(0));
+  const auto window = static_cast<int>(state.range(1));
+  BenchShard shard;
+  net::Socket actor(shard.peer_ctx(), net::SocketType::kDealer);
+  actor.connect(shard.server().insert_endpoint());
+  const std::vector<uint8_t> message = hfo_batch(batch);
+  net::Message ack;
+  int unacked = 0;
+  int64_t sent = 0;
+  for (auto _ : state) {
+    if (unacked == window) {
+      if (!actor.recv(ack, 5000)) {
+        state.SkipWithError("no InsertAck within 5 s");
+        break;
+      }
+      --unacked;  // one ack per batch read: each frees one batch
+    }
+    actor.send(message, -1);
+    ++unacked;
+    sent += batch;
+  }
+  shard.wait_inserted(sent);
+  state.SetItemsProcessed(sent);
+  state.counters["malformed"] = static_cast<double>(shard.server().counters().malformed);
+}
+BENCHMARK(BM_ReplayInsertTcpAcked)
+    ->Args({64, 1})
+    ->Args({64, 2})
+    ->Args({64, 4})
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_ReplaySampleTcp(benchmark::State& state) {
   const int in_flight = static_cast<int>(state.range(0));
