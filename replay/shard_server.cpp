@@ -203,7 +203,7 @@ ShardServer::ShardServer(net::Context& ctx, ShardServerOptions options, ShardCon
         "replay shard: join_retry_ms, poll_ms, insert_recv_hwm and max_insert_message_bytes must be >= 1");
   }
   insert_.set_recv_hwm(options_.insert_recv_hwm);
-  insert_.set_kernel_buffers(1 << 16, 1 << 16);  // backpressure within a few batches (see transport.hpp)
+  insert_.set_kernel_buffers(1 << 16, 1 << 16);  // small per-connection buffers; the actors window their sends
   insert_.set_max_message_bytes(options_.max_insert_message_bytes);
   sample_.set_max_message_bytes(kMaxSampleRequestBytes);
   sample_.set_router_mandatory(true);  // a reply to a vanished learner fails visibly (counted)
