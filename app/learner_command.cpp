@@ -150,11 +150,6 @@ void run_learner(const LearnerCliOptions& o) {
     run.record_env_steps(e.steps);
     run.record_episode({e.status, e.ret, e.steps, e.actor_id, e.policy_version, e.scripted});
   };
-  server.on_update = [&](const UpdateStats& s) {
-    learner_metrics.on_update(s, algorithm->updates());
-    run.record_update(s);
-    run.evaluate_if_due();
-  };
   server.on_tick = [&](const LearnerCounters& k) {
     learner_metrics.on_tick(k, algorithm->updates(), server.metrics_urls().size());
     if (run.checkpoint_due()) {
@@ -196,7 +191,11 @@ void run_learner(const LearnerCliOptions& o) {
                 server.weights_endpoint().c_str());
     std::fflush(stdout);
   }
-  server.run();
+  // The run's updates draw from the shards; the server serves the sockets while they wait.
+  while (run.update(server)) {
+    learner_metrics.on_update(run.last_update(), algorithm->updates());
+    run.evaluate_if_due();
+  }
   server.on_tick(server.counters());  // a last metrics row with the final counters
   run.finish();
   g_server = nullptr;

@@ -21,6 +21,7 @@
 #include "envs/hfo/scripted_offense.hpp"
 #include "learner/algorithm.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/sampler.hpp"
 #include "learner/training_run.hpp"
 #include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"
@@ -47,7 +48,6 @@ class Trainer {
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
         demo_(c.demo_shot),
         sample_rng_(mix_seeds(c.seed, 3)),
-        batch_(obs_dim_, width_, c.ddpg.batch_size),
         episode_(env_->max_episode_steps(), obs_dim_, width_),
         obs_(static_cast<size_t>(obs_dim_)),
         next_obs_(static_cast<size_t>(obs_dim_)),
@@ -57,12 +57,12 @@ class Trainer {
              *eval_env_) {
     if (algorithm_->clones_demonstrations()) {
       demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
-      demo_batch_.emplace(obs_dim_, width_, c.ddpg.batch_size);
       if (c.exploration.demo_relabel) {
         labelled_.emplace(env_->max_episode_steps(), obs_dim_, width_);
         label_.resize(static_cast<size_t>(width_));
       }
     }
+    sampler_.emplace(replay_, demo_replay_ ? &*demo_replay_ : nullptr, sample_rng_, c.ddpg.batch_size, c.replay.warmup);
   }
 
   TrainSummary run();
@@ -87,8 +87,6 @@ class Trainer {
   // The scripted offense's action for obs_ as an actor output (score 1 for its action, -1 for
   // the others, its parameters; the other parameters are the actor's own, net_out_).
   int demo_action(std::span<float> out);
-  // A full sampled batch as the update reads it (no copy).
-  [[nodiscard]] BatchView view_of(const BatchBuffers& b) const;
   [[nodiscard]] bool should_stop() const;
 
   ExperimentConfig c_;
@@ -109,7 +107,6 @@ class Trainer {
   // When the learner clones (ddpg.demo_bc_weight > 0): the demonstrated transitions again, kept
   // for cloning (they also go into replay_).
   std::optional<ReplayBuffer> demo_replay_;
-  std::optional<BatchBuffers> demo_batch_;
   // With exploration.demo_relabel: the agent's steps of the running episode with the scripted
   // offense's action in place of the agent's, flushed into demo_replay_ at its end.
   std::optional<EpisodeBuffer> labelled_;
@@ -117,7 +114,7 @@ class Trainer {
   EpsilonGreedy explore_;
   hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
   Rng sample_rng_;
-  BatchBuffers batch_;
+  std::optional<LocalSampler> sampler_;  // the updates' minibatches: replay_, and demo_replay_ to clone
   EpisodeBuffer episode_;
   std::vector<float> obs_, next_obs_, net_out_, stored_;
 
@@ -165,18 +162,6 @@ void Trainer::log_tick(bool force) {
     std::printf("\n");
     std::fflush(stdout);
   }
-}
-
-BatchView Trainer::view_of(const BatchBuffers& b) const {
-  const int B = c_.ddpg.batch_size;
-  return {
-      Eigen::Map<const Eigen::MatrixXf>(b.states.data(), obs_dim_, B),
-      Eigen::Map<const Eigen::MatrixXf>(b.actions.data(), width_, B),
-      Eigen::Map<const Eigen::VectorXf>(b.rewards.data(), B),
-      Eigen::Map<const Eigen::MatrixXf>(b.next_states.data(), obs_dim_, B),
-      Eigen::Map<const Eigen::VectorXf>(b.terminal.data(), B),
-      Eigen::Map<const Eigen::VectorXf>(b.mc_returns.data(), B),
-  };
 }
 
 int Trainer::demo_action(std::span<float> out) {
@@ -260,18 +245,9 @@ TrainSummary Trainer::run() {
       update_credit_ += c_.train.updates_per_step;
       // Limits are checked at episode ends only (see should_stop), so a run stopped at N updates
       // and resumed passes through exactly the states of a run that never stopped.
-      while (update_credit_ >= 1.0 && replay_.size() >= c_.replay.warmup) {
-        replay_.sample(sample_rng_, c_.ddpg.batch_size, batch_);
-        const int B = c_.ddpg.batch_size;
-        if (demo_replay_ && demo_replay_->size() > 0) {
-          demo_replay_->sample(sample_rng_, B, *demo_batch_);
-          const BatchView demos = view_of(*demo_batch_);
-          run_.record_update(algorithm_->update(view_of(batch_), &demos));
-        } else {
-          run_.record_update(algorithm_->update(view_of(batch_)));
-        }
+      while (update_credit_ >= 1.0 && run_.update(*sampler_)) {
         if (o_.metrics != nullptr) {
-          o_.metrics->on_update(run_.last_update(), algorithm_->updates(), B);
+          o_.metrics->on_update(run_.last_update(), algorithm_->updates(), c_.ddpg.batch_size);
         }
         update_credit_ -= 1.0;
         if (algorithm_->updates() % std::max<int64_t>(1, c_.cluster.publish_every_updates) == 0) {

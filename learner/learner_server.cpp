@@ -254,57 +254,47 @@ BatchView view_of(const wire::TransitionRows& rows, std::vector<float>& terminal
 }
 }  // namespace
 
-void LearnerServer::handle_shard(Shard& shard) {
+const Sample* LearnerServer::take_reply(Shard& shard) {
   net::Message& msg = reply_;  // reused: its aligned copy buffer grows once
   const auto obs = static_cast<uint32_t>(algorithm_.obs_dim());
   const auto act = static_cast<uint32_t>(algorithm_.output_width());
   const int B = algorithm_.batch_size();
-  std::vector<float>& terminal = terminal_scratch_;
-  // At most one reply per call: the run loop alternates shards and the join socket, so
-  // heartbeats and episode reports are answered between updates.
-  if (shard.dealer.recv(msg, 0)) {
-    shard.in_flight = std::max(0, shard.in_flight - 1);
-    shard.last_heard = Clock::now();
-    const wire::Envelope* env = wire::open_envelope(msg.bytes());
-    if (env == nullptr || env->payload_type() != wire::Payload::SampleReply) {
-      note_malformed("shard reply is not a SampleReply");
-      return;
-    }
-    const wire::TransitionBatch* b = env->payload_as_SampleReply()->batch();
-    if (!wire::valid_batch(b, obs, act, static_cast<uint32_t>(B)) || b->count() != static_cast<uint32_t>(B)) {
-      note_malformed("SampleReply with wrong sizes");
-      return;
-    }
-    const wire::TransitionBatch* d = config_.clone_demos ? env->payload_as_SampleReply()->demos() : nullptr;
-    if (d != nullptr &&
-        (!wire::valid_batch(d, obs, act, static_cast<uint32_t>(B)) || d->count() != static_cast<uint32_t>(B))) {
-      note_malformed("SampleReply with demonstrations of wrong sizes");
-      return;
-    }
-    // Ask for the next batch before updating, so the shard works while we do.
-    request_samples(shard);
-    const BatchView view = view_of(wire::rows_of(b), terminal);
-    UpdateStats stats;
-    if (d != nullptr) {
-      const BatchView demos = view_of(wire::rows_of(d), demo_terminal_scratch_);
-      stats = algorithm_.update(view, &demos);
-      counters_.demo_samples_received += B;
-    } else {
-      stats = algorithm_.update(view);
-    }
-    ++counters_.updates;
-    counters_.samples_received += B;
-    shard.samples += B;
-    if (on_update) {
-      on_update(stats);
-    }
-    if (algorithm_.updates() - last_published_at_ >= config_.publish_every_updates) {
-      publish_weights();
-    }
-    if (stop_.load() || algorithm_.updates() >= config_.max_updates) {
-      return;
-    }
+  // At most one reply per call: the loop alternates shards and the join socket, so heartbeats
+  // and episode reports are answered between updates.
+  if (!shard.dealer.recv(msg, 0)) {
+    return nullptr;
   }
+  shard.in_flight = std::max(0, shard.in_flight - 1);
+  shard.last_heard = Clock::now();
+  const wire::Envelope* env = wire::open_envelope(msg.bytes());
+  if (env == nullptr || env->payload_type() != wire::Payload::SampleReply) {
+    note_malformed("shard reply is not a SampleReply");
+    return nullptr;
+  }
+  const wire::TransitionBatch* b = env->payload_as_SampleReply()->batch();
+  if (!wire::valid_batch(b, obs, act, static_cast<uint32_t>(B)) || b->count() != static_cast<uint32_t>(B)) {
+    note_malformed("SampleReply with wrong sizes");
+    return nullptr;
+  }
+  const wire::TransitionBatch* d = config_.clone_demos ? env->payload_as_SampleReply()->demos() : nullptr;
+  if (d != nullptr &&
+      (!wire::valid_batch(d, obs, act, static_cast<uint32_t>(B)) || d->count() != static_cast<uint32_t>(B))) {
+    note_malformed("SampleReply with demonstrations of wrong sizes");
+    return nullptr;
+  }
+  // Ask for the next batch before the caller updates, so the shard works while it does.
+  request_samples(shard);
+  sample_.batch.reset();
+  sample_.batch.emplace(view_of(wire::rows_of(b), terminal_scratch_));
+  sample_.demos.reset();
+  if (d != nullptr) {
+    sample_.demos.emplace(view_of(wire::rows_of(d), demo_terminal_scratch_));
+    counters_.demo_samples_received += B;
+  }
+  ++counters_.updates;  // the caller updates on it at once
+  counters_.samples_received += B;
+  shard.samples += B;
+  return &sample_;
 }
 
 void LearnerServer::drop_dead_shards() {
@@ -327,13 +317,13 @@ void LearnerServer::shards_changed() {
   counters_.shards = static_cast<int64_t>(shards_.size());
 }
 
-void LearnerServer::run() {
+void LearnerServer::begin() {
+  started_ = true;
   terminal_scratch_.assign(static_cast<size_t>(algorithm_.batch_size()), 0.0F);
   demo_terminal_scratch_.assign(static_cast<size_t>(algorithm_.batch_size()), 0.0F);
-  const auto start = Clock::now();
-  auto last_tick = start;
-  auto waiting_since = Clock::now();
-  bool waiting = false;
+  start_ = Clock::now();
+  last_tick_ = start_;
+  waiting_since_ = Clock::now();
   last_published_at_ = algorithm_.updates();
   publish_weights();
   metrics_urls_.clear();
@@ -343,67 +333,105 @@ void LearnerServer::run() {
   if (on_metrics_urls) {
     on_metrics_urls(metrics_urls_);
   }
-  net::Poller poller;
-  uint64_t poller_version = 0;
   log::info("learner: join {} weights {}", join_endpoint_, weights_endpoint_);
-  while (!stop_.load() && algorithm_.updates() < config_.max_updates) {
-    if (config_.max_seconds > 0.0 &&
-        std::chrono::duration<double>(Clock::now() - start).count() >= config_.max_seconds) {
-      break;
+}
+
+bool LearnerServer::limit_reached() const {
+  return stop_.load() || algorithm_.updates() >= config_.max_updates ||
+         (config_.max_seconds > 0.0 &&
+          std::chrono::duration<double>(Clock::now() - start_).count() >= config_.max_seconds);
+}
+
+void LearnerServer::end_round() {
+  round_open_ = false;
+  if (poller_.readable(0)) {
+    handle_join_socket();
+  }
+  for (auto& s : shards_) {
+    request_samples(*s);
+  }
+  drop_dead_shards();
+  if (republish_at_ && Clock::now() >= *republish_at_) {
+    republish_at_.reset();
+    publish_weights();
+  }
+  // Waiting-for-data accounting: no batch in this round although we asked.
+  if (!round_sampled_) {
+    if (!waiting_) {
+      waiting_ = true;
+      waiting_since_ = Clock::now();
     }
-    if (poller.size() != shards_.size() + 1 || poller_version != map_version_) {
-      poller.clear();
-      poller.add(join_);
-      for (auto& s : shards_) {
-        poller.add(s->dealer);
-      }
-      poller_version = map_version_;
+  } else if (waiting_) {
+    counters_.waiting_for_data_ms += ms_since(waiting_since_);
+    waiting_ = false;
+  }
+  if (ms_since(last_tick_) >= 1000) {
+    last_tick_ = Clock::now();
+    refresh_peers(true);
+    counters_.connections_refused = handshakes_.refused();
+    if (waiting_) {
+      counters_.waiting_for_data_ms += ms_since(waiting_since_);
+      waiting_since_ = Clock::now();
     }
-    const int64_t before = algorithm_.updates();
-    const size_t polled = shards_.size();
-    poller.poll(20);
-    // Shards first: handling the join socket may add or replace shards.
-    for (size_t i = 0; i < polled; ++i) {
-      if (poller.readable(i + 1)) {
-        handle_shard(*shards_[i]);
-      }
-    }
-    if (poller.readable(0)) {
-      handle_join_socket();
-    }
-    for (auto& s : shards_) {
-      request_samples(*s);
-    }
-    drop_dead_shards();
-    if (republish_at_ && Clock::now() >= *republish_at_) {
-      republish_at_.reset();
-      publish_weights();
-    }
-    // Waiting-for-data accounting: no update in this round although we tried.
-    if (algorithm_.updates() == before) {
-      if (!waiting) {
-        waiting = true;
-        waiting_since = Clock::now();
-      }
-    } else if (waiting) {
-      counters_.waiting_for_data_ms += ms_since(waiting_since);
-      waiting = false;
-    }
-    if (ms_since(last_tick) >= 1000) {
-      last_tick = Clock::now();
-      refresh_peers(true);
-      counters_.connections_refused = handshakes_.refused();
-      if (waiting) {
-        counters_.waiting_for_data_ms += ms_since(waiting_since);
-        waiting_since = Clock::now();
-      }
-      if (on_tick) {
-        on_tick(counters_);
-      }
+    if (on_tick) {
+      on_tick(counters_);
     }
   }
-  counters_.connections_refused = handshakes_.refused();
-  publish_weights();
+}
+
+const Sample* LearnerServer::next() {
+  if (finished_) {
+    return nullptr;
+  }
+  if (!started_) {
+    begin();
+  }
+  // The caller updated on the previous sample: publish when it is time.
+  if (algorithm_.updates() - last_published_at_ >= config_.publish_every_updates) {
+    publish_weights();
+  }
+  for (;;) {
+    if (limit_reached()) {
+      finished_ = true;
+      counters_.connections_refused = handshakes_.refused();
+      publish_weights();
+      return nullptr;
+    }
+    if (!round_open_) {
+      if (poller_.size() != shards_.size() + 1 || poller_version_ != map_version_) {
+        poller_.clear();
+        poller_.add(join_);
+        for (auto& s : shards_) {
+          poller_.add(s->dealer);
+        }
+        poller_version_ = map_version_;
+      }
+      polled_ = shards_.size();
+      poller_.poll(20);
+      cursor_ = 0;
+      round_open_ = true;
+      round_sampled_ = false;
+    }
+    // Shards first, each once per round: handling the join socket may add or replace shards.
+    while (cursor_ < polled_) {
+      const size_t i = cursor_++;
+      if (poller_.readable(i + 1)) {
+        if (const Sample* s = take_reply(*shards_[i])) {
+          round_sampled_ = true;
+          return s;
+        }
+      }
+    }
+    end_round();
+  }
+}
+
+void LearnerServer::run() {
+  while (const std::optional<UpdateStats> stats = update_from(*this, algorithm_)) {
+    if (on_update) {
+      on_update(*stats);
+    }
+  }
 }
 
 }  // namespace pamdp

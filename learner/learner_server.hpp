@@ -1,9 +1,9 @@
 // The learner role of the distributed system (docs/protocol.md): binds the join socket
 // (ROUTER) and the weights broadcast (PUB), hands out the cluster map, keeps several sample
-// requests in flight on every replay shard, runs the algorithm's updates on the replies, publishes weights
-// every N updates, and collects episode reports.
+// requests in flight on every replay shard, hands the replies to the run's updates as a Sampler
+// (learner/sampler.hpp), publishes weights every N updates, and collects episode reports.
 //
-// One thread runs run(); stop() may be called from any thread or a signal handler. Received
+// One thread calls next() (or run()); stop() may be called from any thread or a signal handler. Received
 // buffers are verified before use; a bad message is counted and dropped. The update path reads
 // sampled rows in place from the received buffers (row-major rows are the column-major
 // obs x batch matrices the update wants), so it copies nothing per sample.
@@ -22,6 +22,7 @@
 
 #include "core/transport.hpp"
 #include "learner/algorithm.hpp"
+#include "learner/sampler.hpp"
 
 namespace pamdp {
 
@@ -72,28 +73,34 @@ struct EpisodeSummary {
   bool scripted = false;    // a demonstration: the teacher played it
 };
 
-class LearnerServer {
+class LearnerServer final : public Sampler {
  public:
   // `algorithm` is owned by the caller and must outlive the server. Its acting networks are
   // synced to the host before each broadcast.
   LearnerServer(net::Context& ctx, Algorithm& algorithm, LearnerServerConfig config);
-  ~LearnerServer();
+  ~LearnerServer() override;
 
   // Resolved, connectable endpoints (valid after construction).
   [[nodiscard]] const std::string& join_endpoint() const { return join_endpoint_; }
   [[nodiscard]] const std::string& weights_endpoint() const { return weights_endpoint_; }
 
-  // Called on the learner thread: after every update (for logging, checkpoints) and for every
-  // episode report. Either may be empty.
-  std::function<void(const UpdateStats&)> on_update;
+  // Called on the learner thread for every episode report. May be empty.
   std::function<void(const EpisodeSummary&)> on_episode;
+  // Called by run() after every update. May be empty.
+  std::function<void(const UpdateStats&)> on_update;
   // Called about once per second with the counters (progress lines, metrics).
   std::function<void(const LearnerCounters&)> on_tick;
   // Called on the learner thread when the cluster's metrics URLs change (a peer joins with one,
   // or is silent for peer_timeout_ms), and once when run() starts.
   std::function<void(const std::vector<std::string>& urls)> on_metrics_urls;
 
-  // Runs until stop(), max_updates or max_seconds.
+  // The next shard reply as a minibatch, valid until the next call; the caller updates on it at
+  // once (the counters count it as an update). Serves the sockets meanwhile: joins, heartbeats,
+  // episode reports, ticks, dead shards, and the weights every publish_every_updates updates
+  // counted since the previous call. Waits as long as no shard has data; nullptr, after a last
+  // broadcast, once stop(), max_updates or max_seconds ends the run.
+  const Sample* next() override;
+  // next() and an update on every sample (on_update after each), until next() ends the run.
   void run();
   void stop() { stop_.store(true); }
   [[nodiscard]] const LearnerCounters& counters() const { return counters_; }
@@ -115,7 +122,12 @@ class LearnerServer {
   };
   void handle_join_socket();
   void refresh_peers(bool drop_silent);
-  void handle_shard(Shard& shard);
+  // One reply read from the shard: the minibatch it carries, or nullptr (none, or malformed).
+  const Sample* take_reply(Shard& shard);
+  void begin();
+  [[nodiscard]] bool limit_reached() const;
+  // After a round's shards were read: the join socket, requests, dead shards, ticks.
+  void end_round();
   void request_samples(Shard& shard);
   void drop_dead_shards();
   // After shards_ changed: a new map version, and the shard count the counters report.
@@ -147,6 +159,21 @@ class LearnerServer {
   std::optional<std::chrono::steady_clock::time_point> republish_at_;
   std::map<std::string, Peer> peers_;  // by join-socket identity (bytes)
   std::vector<std::string> metrics_urls_;
+  // The sampling loop's state between next() calls: one poll is a round, whose readable shards
+  // are read in turn, one reply per call.
+  Sample sample_;
+  net::Poller poller_;
+  uint64_t poller_version_ = 0;
+  size_t polled_ = 0;
+  size_t cursor_ = 0;
+  bool round_open_ = false;
+  bool round_sampled_ = false;
+  bool started_ = false;
+  bool finished_ = false;
+  bool waiting_ = false;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_tick_;
+  std::chrono::steady_clock::time_point waiting_since_;
 };
 
 }  // namespace pamdp

@@ -127,6 +127,14 @@ void TrainingRun::record_episode(const FinishedEpisode& e) {
   logs_->episode(row);
 }
 
+bool TrainingRun::update(Sampler& sampler) {
+  const std::optional<UpdateStats> stats = update_from(sampler, algorithm_);
+  if (stats) {
+    last_stats_ = *stats;
+  }
+  return stats.has_value();
+}
+
 bool TrainingRun::evaluation_due() const {
   return algorithm_.updates() >= next_eval_;
 }

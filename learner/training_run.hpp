@@ -5,15 +5,17 @@
 //            loads checkpoint.ckpt, the run's clock and counters, and refills the last-100
 //            training rates from episodes.csv;
 //   episodes every finished episode is counted and written to episodes.csv;
-//   updates  the latest update's statistics feed the metrics rows;
+//   updates  every update draws its minibatch through one seam, a Sampler (learner/sampler.hpp):
+//            the in-process replay buffer for `train`, the replay shards for `learner`; the
+//            latest update's statistics feed the metrics rows;
 //   evaluate every train.eval_every_updates updates: a greedy evaluation, confirmed on more
 //            episodes before it replaces best.ckpt (BestEval), reported to the live metrics;
 //   rows     metrics.csv rows with the rates since the previous row;
 //   save     checkpoint.ckpt (with the caller's own state: random streams, replay snapshots);
 //   finish   a last checkpoint and the logs flushed.
 //
-// What differs between the two stays with the caller: where batches come from, who plays the
-// episodes, the extra metrics columns and the progress line. The run directory's files are
+// What differs between the two stays with the caller: which sampler, who plays the episodes,
+// the extra metrics columns and the progress line. The run directory's files are
 // described in learner/run_logs.hpp. Not thread-safe: one thread drives a run.
 #pragma once
 
@@ -33,6 +35,7 @@
 #include "learner/checkpoint.hpp"
 #include "learner/evaluation.hpp"
 #include "learner/run_logs.hpp"
+#include "learner/sampler.hpp"
 
 namespace pamdp {
 
@@ -123,8 +126,9 @@ class TrainingRun {
   // Counts the episode (its steps are counted by record_env_steps), writes its row (numbered,
   // timed and stamped with the updates here).
   void record_episode(const FinishedEpisode& e);
-  // The latest update's statistics, reported by the next metrics row.
-  void record_update(const UpdateStats& s) { last_stats_ = s; }
+  // One update on the sampler's next minibatch; its statistics feed the next metrics row. False,
+  // and no update, when the sampler had none.
+  bool update(Sampler& sampler);
 
   // True once the updates reached the next evaluation point.
   [[nodiscard]] bool evaluation_due() const;

@@ -49,23 +49,23 @@ RunSpec spec_in(const fs::path& dir, bool keeps) {
   return spec;
 }
 
-// A learner with a zero batch to step its update counter.
+// A sampler that hands out one zero batch: steps the update counter.
+struct ZeroSampler final : Sampler {
+  BatchBuffers batch;
+  Sample sample;
+  ZeroSampler(int obs, int width) : batch(obs, width, 4) { sample.batch.emplace(view_of(batch, 4)); }
+  const Sample* next() override { return &sample; }
+};
+
 struct Learner {
   toy::ReachStopEnv env;
   toy::ReachStopEnv eval_env;
   DdpgAlgorithm ddpg{env.observation_size(), env.action_space(), tiny_config(), 5, UpdateDevice::kCpu};
-  BatchBuffers batch{env.observation_size(), env.action_space().output_width(), 4};
+  ZeroSampler sampler{env.observation_size(), env.action_space().output_width()};
 
   void update(TrainingRun& run, int n) {
-    const int obs = env.observation_size();
-    const int width = env.action_space().output_width();
     for (int i = 0; i < n; ++i) {
-      run.record_update(ddpg.update({Eigen::Map<const Eigen::MatrixXf>(batch.states.data(), obs, 4),
-                                     Eigen::Map<const Eigen::MatrixXf>(batch.actions.data(), width, 4),
-                                     Eigen::Map<const Eigen::VectorXf>(batch.rewards.data(), 4),
-                                     Eigen::Map<const Eigen::MatrixXf>(batch.next_states.data(), obs, 4),
-                                     Eigen::Map<const Eigen::VectorXf>(batch.terminal.data(), 4),
-                                     Eigen::Map<const Eigen::VectorXf>(batch.mc_returns.data(), 4)}));
+      ASSERT_TRUE(run.update(sampler));
     }
   }
 };
