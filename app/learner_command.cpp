@@ -42,32 +42,10 @@ extern "C" void on_learner_signal(int /*sig*/) {
 using LearnerCliOptions = RunCliOptions;
 
 void run_learner(const LearnerCliOptions& o) {
-  ExperimentConfig c;
-  std::string run_dir;
-  const bool resume = !o.resume.empty();
-  if (resume) {
-    if (!o.config.empty()) {
-      throw std::runtime_error("--resume uses the config saved in the run directory; drop --config");
-    }
-    run_dir = o.resume;
-    if (!fs::exists(fs::path(run_dir) / "config.toml") || !fs::exists(fs::path(run_dir) / "checkpoint.ckpt")) {
-      throw std::runtime_error("--resume " + run_dir + ": no config.toml and checkpoint.ckpt there");
-    }
-    c = load_experiment_config((fs::path(run_dir) / "config.toml").string(), o.sets);
-  } else {
-    c = load_experiment_config(o.config, o.sets);
-    if (o.seed >= 0) {
-      c.seed = static_cast<uint64_t>(o.seed);
-    }
-    if (o.run_dir.empty()) {
-      run_dir = timestamped_run_dir("cluster-seed" + std::to_string(c.seed));
-    } else {
-      run_dir = o.run_dir;
-    }
-    if (fs::exists(fs::path(run_dir) / "checkpoint.ckpt")) {
-      throw std::runtime_error("run directory '" + run_dir + "' already holds a run; use --resume " + run_dir);
-    }
-  }
+  ResolvedRun resolved = resolve_run(o, "learner", "cluster-");
+  ExperimentConfig& c = resolved.config;
+  const std::string& run_dir = resolved.run_dir;
+  const bool resume = resolved.resume;
   // Before anything is written or bound: no cluster socket on the network without CURVE unless
   // asked for.
   const SecurityOptions security{

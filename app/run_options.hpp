@@ -4,10 +4,13 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "app/experiment_config.hpp"
+#include "app/run_support.hpp"
 
 namespace pamdp::app {
 
@@ -31,6 +34,47 @@ struct RunCliOptions {
     }
   }
 };
+
+// What a run starts from: a new run's config (--config, --set, --seed) and directory (--run-dir,
+// or runs/<time>-<label_prefix>seed<N>), or the run in --resume DIR (its config.toml, with --set
+// on top). Throws naming the fix when the options clash or the directories do not fit.
+struct ResolvedRun {
+  ExperimentConfig config;
+  std::string run_dir;
+  bool resume = false;
+};
+
+inline ResolvedRun resolve_run(const RunCliOptions& o, const std::string& command, const std::string& label_prefix) {
+  namespace fs = std::filesystem;
+  ResolvedRun r;
+  if (!o.resume.empty()) {
+    if (!o.config.empty()) {
+      throw std::runtime_error(
+          "--resume uses the config saved in the run directory; drop --config (use --set to change limits)");
+    }
+    const fs::path dir(o.resume);
+    if (!fs::exists(dir / "config.toml") || !fs::exists(dir / "checkpoint.ckpt")) {
+      throw std::runtime_error(
+          "--resume " + o.resume +
+          ": no config.toml and checkpoint.ckpt there; pass the run directory of an earlier pamdp " + command);
+    }
+    r.config = load_experiment_config((dir / "config.toml").string(), o.sets);
+    r.run_dir = o.resume;
+    r.resume = true;
+    return r;
+  }
+  r.config = load_experiment_config(o.config, o.sets);
+  if (o.seed >= 0) {
+    r.config.seed = static_cast<uint64_t>(o.seed);
+  }
+  r.run_dir =
+      o.run_dir.empty() ? timestamped_run_dir(label_prefix + "seed" + std::to_string(r.config.seed)) : o.run_dir;
+  if (fs::exists(fs::path(r.run_dir) / "checkpoint.ckpt")) {
+    throw std::runtime_error("run directory '" + r.run_dir + "' already holds a run; continue it with --resume " +
+                             r.run_dir + " or choose another --run-dir");
+  }
+  return r;
+}
 
 // The help texts that differ between the two commands.
 struct RunOptionHelp {

@@ -32,33 +32,11 @@ struct TrainCliOptions : RunCliOptions {
 
 void run_train(const TrainCliOptions& o) {
   namespace fs = std::filesystem;
+  ResolvedRun run = resolve_run(o, "train", "");
+  ExperimentConfig& config = run.config;
   TrainOptions opts;
-  ExperimentConfig config;
-  if (!o.resume.empty()) {
-    if (!o.config.empty()) {
-      throw std::runtime_error(
-          "--resume uses the config saved in the run directory; drop --config (use --set to change limits)");
-    }
-    const fs::path cfg = fs::path(o.resume) / "config.toml";
-    if (!fs::exists(cfg) || !fs::exists(fs::path(o.resume) / "checkpoint.ckpt")) {
-      throw std::runtime_error(
-          "--resume " + o.resume +
-          ": no config.toml and checkpoint.ckpt there; pass the run directory of an earlier pamdp train");
-    }
-    config = load_experiment_config(cfg.string(), o.sets);
-    opts.run_dir = o.resume;
-    opts.resume = true;
-  } else {
-    config = load_experiment_config(o.config, o.sets);
-    if (o.seed >= 0) {
-      config.seed = static_cast<uint64_t>(o.seed);
-    }
-    opts.run_dir = o.run_dir.empty() ? timestamped_run_dir("seed" + std::to_string(config.seed)) : o.run_dir;
-    if (fs::exists(fs::path(opts.run_dir) / "checkpoint.ckpt")) {
-      throw std::runtime_error("run directory '" + opts.run_dir + "' already holds a run; continue it with --resume " +
-                               opts.run_dir + " or choose another --run-dir");
-    }
-  }
+  opts.run_dir = run.run_dir;
+  opts.resume = run.resume;
   opts.quiet = o.quiet;
   opts.stop = &g_stop;
   o.apply_metrics_overrides(config);
