@@ -284,7 +284,6 @@ const Sample* LearnerServer::take_reply(Shard& shard) {
   }
   // Ask for the next batch before the caller updates, so the shard works while it does.
   request_samples(shard);
-  sample_.batch.reset();
   sample_.batch.emplace(view_of(wire::rows_of(b), terminal_scratch_));
   sample_.demos.reset();
   if (d != nullptr) {

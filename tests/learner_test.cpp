@@ -27,6 +27,7 @@
 #include "learner/ddpg.hpp"
 #include "learner/ddpg_algorithm.hpp"
 #include "learner/gradient_bounds.hpp"
+#include "learner/sampler.hpp"
 #include "learner/update_backend.hpp"
 #include "replay/episode_buffer.hpp"
 #include "replay/replay_buffer.hpp"
@@ -349,15 +350,6 @@ DdpgConfig tiny_config() {
   return c;
 }
 
-BatchView view_of(const BatchBuffers& b, int obs, int act, int B) {
-  return {Eigen::Map<const Eigen::MatrixXf>(b.states.data(), obs, B),
-          Eigen::Map<const Eigen::MatrixXf>(b.actions.data(), act, B),
-          Eigen::Map<const Eigen::VectorXf>(b.rewards.data(), B),
-          Eigen::Map<const Eigen::MatrixXf>(b.next_states.data(), obs, B),
-          Eigen::Map<const Eigen::VectorXf>(b.terminal.data(), B),
-          Eigen::Map<const Eigen::VectorXf>(b.mc_returns.data(), B)};
-}
-
 TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   toy::ReachStopEnv env;
   Ddpg d(3, env.action_space(), tiny_config(), 5);
@@ -372,7 +364,7 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   }
   b.rewards = {1, 0, -1, 0.5F};
   b.terminal = {0, 1, 0, 0};
-  d.update(view_of(b, 3, 3, 4));
+  d.update(view_of(b, 4));
   // theta' = tau theta_new + (1 - tau) theta_old, with theta_old the initial copy.
   for (size_t i = 0; i < actor_before.size(); ++i) {
     const float expect = 0.25F * d.actor().params()[i] + 0.75F * actor_before[i];
@@ -450,7 +442,7 @@ TEST(Ddpg, LearningRatesDecayLinearlyThenHold) {
   BatchBuffers b(3, 3, 4);
   const double want[] = {1.0, 0.775, 0.55, 0.325, 0.1, 0.1};
   for (const double scale : want) {
-    d.update(view_of(b, 3, 3, 4));
+    d.update(view_of(b, 4));
     EXPECT_DOUBLE_EQ(d.actor_optimizer().config().learning_rate, 1e-3 * scale) << "after " << d.updates();
     EXPECT_DOUBLE_EQ(d.critic_optimizer().config().learning_rate, 2e-3 * scale) << "after " << d.updates();
   }
@@ -458,7 +450,7 @@ TEST(Ddpg, LearningRatesDecayLinearlyThenHold) {
   c.lr_decay_updates = 0;
   Ddpg constant(3, env.action_space(), c, 5);
   for (int i = 0; i < 3; ++i) {
-    constant.update(view_of(b, 3, 3, 4));
+    constant.update(view_of(b, 4));
   }
   EXPECT_EQ(constant.actor_optimizer().config().learning_rate, 1e-3);
 }
@@ -492,8 +484,8 @@ TEST(Ddpg, CloningGradientMatchesFiniteDifferences) {
     b.terminal = {0, 1, 0, 0};
     // MOVE at 0.8 and -0.6, then STOP twice (its velocity entry is not a demonstration).
     demo.actions = {1, -1, 0.8F, 1, -1, -0.6F, -1, 1, 0.5F, -1, 1, -0.9F};
-    const BatchView batch = view_of(b, 3, 3, 4);
-    const BatchView demos = view_of(demo, 3, 3, 4);
+    const BatchView batch = view_of(b, 4);
+    const BatchView demos = view_of(demo, 4);
     const std::vector<float> before(d.actor().params().begin(), d.actor().params().end());
     const UpdateStats stats = d.update(batch, &demos);
     std::vector<float> after(d.actor().params().begin(), d.actor().params().end());
@@ -578,10 +570,10 @@ TEST(Ddpg, CriticLearnsAFixedTarget) {
   }
   b.rewards = {1.0F, -0.5F, 0.25F, 0.75F};
   b.terminal = {1, 1, 1, 1};
-  const float first = d.update(view_of(b, 3, 3, 4)).critic_loss;
+  const float first = d.update(view_of(b, 4)).critic_loss;
   float last = first;
   for (int i = 0; i < 400; ++i) {
-    last = d.update(view_of(b, 3, 3, 4)).critic_loss;
+    last = d.update(view_of(b, 4)).critic_loss;
   }
   EXPECT_GT(first, 0.05F);
   EXPECT_LT(last, 1e-3F);
@@ -1185,8 +1177,8 @@ TEST(UpdateBackend, CpuIsDdpgUpdate) {
   batch.rewards = {1, 0, -1, 0.5F};
   batch.terminal = {0, 1, 0, 0};
   for (int i = 0; i < 3; ++i) {
-    const UpdateStats sa = a.update(view_of(batch, 3, 3, 4));
-    const UpdateStats sb = backend->update(view_of(batch, 3, 3, 4));
+    const UpdateStats sa = a.update(view_of(batch, 4));
+    const UpdateStats sb = backend->update(view_of(batch, 4));
     EXPECT_EQ(sa.critic_loss, sb.critic_loss);
   }
   backend->sync_to_host();
