@@ -433,6 +433,16 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
     slot.labelled->compute_returns(config.gamma);
     add_rows(*slot.labelled, *demo_batch, wire::kDemoTable);
   }
+  // The ended episode goes out now, in a partial batch if need be, as `pamdp train` puts each
+  // episode into its replay when it ends. Held back until a batch filled, the rows of episodes a
+  // few steps long reached the learner up to a batch's worth of steps late, and MP-DQN on Goal
+  // fell into shooting at once far more often (docs/results.md, "Goal on the cluster").
+  if (!batch.empty()) {
+    send_batch(batch, wire::kReplayTable);
+  }
+  if (demo_batch && !demo_batch->empty()) {
+    send_batch(*demo_batch, wire::kDemoTable);
+  }
   ++slot.episodes;
   const int64_t episode = counters.episodes.fetch_add(1, std::memory_order_relaxed) + 1;
   if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), static_cast<float>(slot.ret),

@@ -56,7 +56,7 @@ namespace pamdp {
 struct ActorLoopConfig {
   ExplorationConfig exploration;  // resolved against the envs' action space
   double gamma = 0.99;
-  int batch_transitions = 64;  // rows per TransitionBatch (cluster.actor_batch_transitions)
+  int batch_transitions = 64;  // most rows per TransitionBatch (cluster.actor_batch_transitions)
   int heartbeat_ms = 1000;
   int peer_timeout_ms = 5000;
   bool apex_epsilon = false;  // per-actor fixed ε instead of the learner's linear schedule

@@ -50,7 +50,7 @@ struct ClusterConfig {
   std::string weights_bind = "tcp://127.0.0.1:5556";  // weights broadcast (PUB)
   std::string advertise_host = "127.0.0.1";           // how peers reach this machine's bound ports
   int64_t publish_every_updates = 100;
-  int actor_batch_transitions = 64;  // transitions per TransitionBatch message
+  int actor_batch_transitions = 64;  // most transitions per TransitionBatch; each episode end sends one
   int actor_batches_in_flight = 2;   // unacknowledged TransitionBatches per actor and shard
   // Samples per inserted transition the shards allow (0: updates_per_step * batch_size, the
   // single-process ratio), and how far inserts may run ahead of / behind it, in transitions.
