@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "actor/acting_policy.hpp"
+#include "actor/episode_player.hpp"
 #include "core/log.hpp"
 #include "core/rng.hpp"
 #include "core/wire.hpp"
@@ -86,25 +87,13 @@ class OutgoingBatch {
 
 struct EnvSlot {
   std::unique_ptr<Env> env;
-  std::vector<float> obs, next_obs, stored;
-  EpisodeBuffer episode;
   std::unique_ptr<Policy> teacher;  // with demonstrations
-  bool demo = false;                // this episode is the teacher's
-  bool label = false;               // the agent's episode, labelled by the teacher (demo_relabel)
-  std::optional<EpisodeBuffer> labelled;
-  std::vector<float> label_output;  // the teacher's label as an output vector
+  EpisodePlayer player;             // its episodes, played as `pamdp train` plays them
   uint64_t seed = 0;
   uint64_t episodes = 0;
-  double ret = 0.0;
-  int steps = 0;
 
-  EnvSlot(std::unique_ptr<Env> e, int obs_dim, int width, uint64_t s)
-      : env(std::move(e)),
-        obs(static_cast<size_t>(obs_dim)),
-        next_obs(static_cast<size_t>(obs_dim)),
-        stored(static_cast<size_t>(width)),
-        episode(env->max_episode_steps(), obs_dim, width),
-        seed(s) {}
+  EnvSlot(std::unique_ptr<Env> e, std::unique_ptr<Policy> t, bool labels, uint64_t s)
+      : env(std::move(e)), teacher(std::move(t)), player(*env, teacher.get(), labels), seed(s) {}
 };
 
 // The sequences of the batches sent to one shard and not yet acknowledged, oldest first: a ring
@@ -206,7 +195,6 @@ struct ActorLoop::Impl {
            const std::function<void(int, double, int)>& on_episode);
 
   void step(EnvSlot& slot);
-  void forward(std::span<const float> obs);
   void finish_episode(EnvSlot& slot, int status);
   void reset(EnvSlot& slot);
 
@@ -241,7 +229,6 @@ struct ActorLoop::Impl {
   // Shapes, fixed by the envs.
   int obs_dim;
   int width;
-  int num_actions;
   const ActionSpace& space;
   uint32_t actor_index;
 
@@ -267,7 +254,7 @@ struct ActorLoop::Impl {
   std::unique_ptr<ActingPolicy> pending_policy;
   std::string pending_algorithm;
   std::vector<NetworkView> weights_networks;
-  std::vector<float> net_out;
+  EpisodePlayer::Act act;  // the acting policy's output (empty until the first weights)
   uint64_t weights_version = 0;
   int64_t updates = 0;
   double eps = 1.0;
@@ -296,27 +283,19 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
       link(std::move(l)),
       obs_dim(first_env(env_list).observation_size()),
       width(env_list.front()->action_space().output_width()),
-      num_actions(env_list.front()->action_space().num_actions()),
       space(env_list.front()->action_space()),
       actor_index(map.actor_index),
       sub(ctx, net::SocketType::kSub),
       explore(env_list.front()->action_space(), config.exploration,
               mix_seeds(config.seed, 1000 + uint64_t{map.actor_index})),
-      net_out(static_cast<size_t>(width)),
       batch(config.batch_transitions, obs_dim, width),
       batch_fbb(static_cast<size_t>(config.batch_transitions) * (2 * area(1, obs_dim) + area(1, width) + 3) * 4 +
                 1024) {
   const uint64_t actor_seed = mix_seeds(config.seed, 2000 + uint64_t{actor_index});
   envs.reserve(env_list.size());
   for (size_t k = 0; k < env_list.size(); ++k) {
-    envs.emplace_back(std::move(env_list[k]), obs_dim, width, mix_seeds(actor_seed, k));
-    if (config.make_teacher) {
-      envs.back().teacher = config.make_teacher();
-    }
-    if (config.exploration.demo_relabel) {
-      envs.back().labelled.emplace(envs.back().env->max_episode_steps(), obs_dim, width);
-      envs.back().label_output.resize(static_cast<size_t>(width));
-    }
+    envs.emplace_back(std::move(env_list[k]), config.make_teacher ? config.make_teacher() : nullptr,
+                      config.exploration.demo_relabel, mix_seeds(actor_seed, k));
   }
   if (config.demo_table) {
     demo_batch.emplace(config.batch_transitions, obs_dim, width);
@@ -373,50 +352,15 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
 }
 
 void ActorLoop::Impl::reset(EnvSlot& slot) {
-  slot.env->reset(mix_seeds(slot.seed, slot.episodes), slot.obs);
-  slot.episode.clear();
-  slot.ret = 0.0;
-  slot.steps = 0;
-  // The draw is skipped when demonstrations are off, so runs without them keep their streams.
   const ExplorationConfig& x = config.exploration;
-  const double share = demo_share(updates, x.demo_fraction, x.demo_anneal_updates);
-  slot.demo = share > 0.0 && explore.rng().uniform() < share;
-  slot.label = slot.labelled.has_value() && !slot.demo;  // the agent plays, the teacher labels
-  if (slot.label) {
-    slot.labelled->clear();
-  }
-  if (slot.demo || slot.label) {
-    slot.teacher->begin_episode();
-  }
-}
-
-void ActorLoop::Impl::forward(std::span<const float> obs) {
-  policy->act(obs, net_out);
+  slot.player.begin(mix_seeds(slot.seed, slot.episodes), demo_share(updates, x.demo_fraction, x.demo_anneal_updates),
+                    explore.rng());
 }
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
-  // At ε = 1 the network's output is never used, so it is not computed (a demonstration stores it
-  // as the parameters of the actions the teacher did not take; a random step keeps its parameters
-  // when exploration.uniform_random_params is off).
-  if (policy != nullptr && (eps < 1.0 || slot.demo || slot.label || !config.exploration.uniform_random_params)) {
-    forward(slot.obs);
-  }
-  const int id = slot.demo ? write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.stored)
-                           : explore.select(net_out, eps, slot.stored);
-  if (slot.label) {  // before the step: the label is for the state the agent acted in
-    write_teacher_output(space, slot.teacher->act(slot.obs), net_out, slot.label_output);
-  }
-  const StepResult sr = slot.env->step(
-      {id, std::span<const float>(slot.stored).subspan(static_cast<size_t>(num_actions))}, slot.next_obs);
-  slot.episode.push(slot.obs, slot.stored, sr.reward, slot.next_obs);
-  if (slot.label) {
-    slot.labelled->push(slot.obs, slot.label_output, sr.reward, slot.next_obs);
-  }
-  slot.ret += sr.reward;
-  ++slot.steps;
-  std::swap(slot.obs, slot.next_obs);
+  const StepResult sr = slot.player.step(act, explore, eps);
   counters.env_steps.fetch_add(1, std::memory_order_relaxed);
-  if (sr.terminal() || slot.episode.size() >= slot.episode.capacity()) {
+  if (slot.player.ended()) {
     finish_episode(slot, sr.status);
   }
 }
@@ -424,14 +368,15 @@ void ActorLoop::Impl::step(EnvSlot& slot) {
 void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   // The last step is terminal, time-outs included, as in the paper's code and `pamdp train`.
   // Returns are computed once per buffer; a demonstration's rows go to both tables.
-  slot.episode.compute_returns(config.gamma);
-  add_rows(slot.episode, batch, wire::kReplayTable);
-  if (slot.demo && demo_batch) {
-    add_rows(slot.episode, *demo_batch, wire::kDemoTable);
+  EpisodePlayer& p = slot.player;
+  p.episode().compute_returns(config.gamma);
+  add_rows(p.episode(), batch, wire::kReplayTable);
+  if (p.demo() && demo_batch) {
+    add_rows(p.episode(), *demo_batch, wire::kDemoTable);
   }
-  if (slot.label) {
-    slot.labelled->compute_returns(config.gamma);
-    add_rows(*slot.labelled, *demo_batch, wire::kDemoTable);
+  if (EpisodeBuffer* labels = p.labels()) {
+    labels->compute_returns(config.gamma);
+    add_rows(*labels, *demo_batch, wire::kDemoTable);
   }
   // The ended episode goes out now, in a partial batch if need be, as `pamdp train` puts each
   // episode into its replay when it ends. Held back until a batch filled, the rows of episodes a
@@ -445,13 +390,12 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   }
   ++slot.episodes;
   const int64_t episode = counters.episodes.fetch_add(1, std::memory_order_relaxed) + 1;
-  if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), static_cast<float>(slot.ret),
-                                static_cast<uint32_t>(slot.steps), status, slot.demo ? 0 : weights_version,
-                                slot.demo)) {
+  if (!link.send_episode_report(actor_index, static_cast<uint64_t>(episode), p.episode_return(),
+                                static_cast<uint32_t>(p.steps()), status, p.demo() ? 0 : weights_version, p.demo())) {
     counters.reports_dropped.fetch_add(1, std::memory_order_relaxed);
   }
-  if (on_episode != nullptr && *on_episode && !slot.demo) {
-    (*on_episode)(status, slot.ret, slot.steps);
+  if (on_episode != nullptr && *on_episode && !p.demo()) {
+    (*on_episode)(status, p.episode_return(), p.steps());
   }
   reset(slot);
 }
@@ -758,6 +702,9 @@ void ActorLoop::Impl::apply_weights(const wire::PolicyWeights* w) {
   }
   pending_policy.reset();
   policy->load(weights_networks, w->bound());
+  if (!act) {
+    act = [this](std::span<const float> obs, std::span<float> out) { policy->act(obs, out); };
+  }
   weights_version = w->version();
   updates = w->updates();
   counters.weights_version.store(static_cast<int64_t>(weights_version), std::memory_order_relaxed);

@@ -71,6 +71,9 @@ class EpsilonGreedy {
   // params); `stored` receives the vector to store in replay (net_output or the random draw).
   // Returns the chosen discrete action id; its parameters are `stored` minus the scores.
   int select(std::span<const float> net_output, double epsilon, std::span<float> stored);
+  // Whether select() at this ε may read net_output: below ε = 1, or when its random steps keep
+  // the network's parameters (exploration.uniform_random_params off).
+  [[nodiscard]] bool uses_output(double epsilon) const { return epsilon < 1.0 || !uniform_random_params_; }
 
   // Arg-max of the scores over unmasked actions.
   [[nodiscard]] int greedy(std::span<const float> output) const;

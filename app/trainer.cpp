@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "actor/episode_player.hpp"
 #include "actor/exploration.hpp"
 #include "app/env_factory.hpp"
 #include "app/progress.hpp"
@@ -48,19 +49,12 @@ class Trainer {
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
         demo_(c.demo_shot),
         sample_rng_(mix_seeds(c.seed, 3)),
-        episode_(env_->max_episode_steps(), obs_dim_, width_),
-        obs_(static_cast<size_t>(obs_dim_)),
-        next_obs_(static_cast<size_t>(obs_dim_)),
-        net_out_(static_cast<size_t>(width_)),
-        stored_(static_cast<size_t>(width_)),
+        player_(*env_, &demo_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
+        act_([this](std::span<const float> obs, std::span<float> out) { algorithm_->act(obs, out); }),
         run_(run_spec(c, o_.run_dir, exploration_, algorithm_->clones_demonstrations()), *algorithm_, *env_,
              *eval_env_) {
     if (algorithm_->clones_demonstrations()) {
       demo_replay_.emplace(c.replay.capacity, obs_dim_, width_);
-      if (c.exploration.demo_relabel) {
-        labelled_.emplace(env_->max_episode_steps(), obs_dim_, width_);
-        label_.resize(static_cast<size_t>(width_));
-      }
     }
     sampler_.emplace(replay_, demo_replay_ ? &*demo_replay_ : nullptr, sample_rng_, c.ddpg.batch_size, c.replay.warmup);
   }
@@ -84,9 +78,6 @@ class Trainer {
     return spec;
   }
   void log_tick(bool force);
-  // The scripted offense's action for obs_ as an actor output (score 1 for its action, -1 for
-  // the others, its parameters; the other parameters are the actor's own, net_out_).
-  int demo_action(std::span<float> out);
   [[nodiscard]] bool should_stop() const;
 
   ExperimentConfig c_;
@@ -104,19 +95,16 @@ class Trainer {
   // no-op.
   std::unique_ptr<Algorithm> algorithm_;
   ReplayBuffer replay_;
-  // When the learner clones (ddpg.demo_bc_weight > 0): the demonstrated transitions again, kept
-  // for cloning (they also go into replay_).
+  // When the learner clones (ddpg.demo_bc_weight > 0): the demonstrated transitions again, and
+  // with exploration.demo_relabel the agent's steps labelled with the scripted offense's actions,
+  // kept for cloning (the demonstrations also go into replay_).
   std::optional<ReplayBuffer> demo_replay_;
-  // With exploration.demo_relabel: the agent's steps of the running episode with the scripted
-  // offense's action in place of the agent's, flushed into demo_replay_ at its end.
-  std::optional<EpisodeBuffer> labelled_;
-  std::vector<float> label_;
   EpsilonGreedy explore_;
-  hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes
+  hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes, labels with demo_relabel
   Rng sample_rng_;
   std::optional<LocalSampler> sampler_;  // the updates' minibatches: replay_, and demo_replay_ to clone
-  EpisodeBuffer episode_;
-  std::vector<float> obs_, next_obs_, net_out_, stored_;
+  EpisodePlayer player_;                 // the episodes, played as the actors play them
+  EpisodePlayer::Act act_;               // the learner's acting networks
 
   double update_credit_ = 0.0;
   TrainingRun run_;  // last: built from the members above
@@ -164,10 +152,6 @@ void Trainer::log_tick(bool force) {
   }
 }
 
-int Trainer::demo_action(std::span<float> out) {
-  return write_teacher_output(space_, demo_.act(obs_), net_out_, out);
-}
-
 TrainSummary Trainer::run() {
   run_.on_eval = [this](const EvalResult& r) {
     if (o_.metrics != nullptr) {
@@ -204,43 +188,21 @@ TrainSummary Trainer::run() {
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);
   }
-  const int num_actions = space_.num_actions();
-
   while (!should_stop()) {
-    // One episode.
-    env_->reset(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())), obs_);
-    episode_.clear();
-    // The draw is skipped when demonstrations are off, so runs without them keep their streams.
-    const double share =
-        demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates);
-    const bool demo = share > 0.0 && explore_.rng().uniform() < share;
-    const bool label = labelled_ && !demo;  // the agent plays, its steps get the teacher's labels
-    if (demo || label) {
-      demo_.begin_episode();
-    }
-    float ep_return = 0.0F;
-    int steps = 0;
-    StepResult sr;
+    // One episode. The demonstration draw is skipped when demonstrations are off, so runs
+    // without them keep their streams.
+    player_.begin(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())),
+                  demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates),
+                  explore_.rng());
+    int status = 0;
     do {
       const double eps = linear_epsilon(algorithm_->updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                         exploration_.epsilon_anneal_updates);
-      algorithm_->act(obs_, net_out_);
-      const int id = demo ? demo_action(stored_) : explore_.select(net_out_, eps, stored_);
-      if (label) {
-        demo_action(label_);  // before the step: the label is for the state the agent acted in
-      }
-      sr = env_->step({id, std::span<const float>(stored_).subspan(static_cast<size_t>(num_actions))}, next_obs_);
-      episode_.push(obs_, stored_, sr.reward, next_obs_);
-      if (label) {
-        labelled_->push(obs_, label_, sr.reward, next_obs_);
-      }
-      ep_return += sr.reward;
-      ++steps;
+      status = player_.step(act_, explore_, eps).status;
       run_.record_env_steps(1);
       if (o_.metrics != nullptr) {
         o_.metrics->on_step(eps);
       }
-      std::swap(obs_, next_obs_);
 
       update_credit_ += c_.train.updates_per_step;
       // Limits are checked at episode ends only (see should_stop), so a run stopped at N updates
@@ -258,19 +220,21 @@ TrainSummary Trainer::run() {
         update_credit_ = std::min(update_credit_, 1.0);  // no debt piles up during warm-up
       }
       log_tick(false);
-    } while (!sr.terminal() && static_cast<size_t>(steps) < episode_.capacity());
+    } while (!player_.ended());
 
-    flush_episode(episode_, c_.ddpg.gamma, replay_, demo && demo_replay_ ? &*demo_replay_ : nullptr);
-    if (label) {
-      flush_episode(*labelled_, c_.ddpg.gamma, *demo_replay_);
+    const bool demo = player_.demo();
+    flush_episode(player_.episode(), c_.ddpg.gamma, replay_, demo && demo_replay_ ? &*demo_replay_ : nullptr);
+    if (EpisodeBuffer* labels = player_.labels()) {
+      flush_episode(*labels, c_.ddpg.gamma, *demo_replay_);
     }
     algorithm_->sync_acting();
     if (o_.metrics != nullptr) {
-      o_.metrics->on_episode(sr.status, ep_return, steps, static_cast<int64_t>(replay_.size()), !demo);
+      o_.metrics->on_episode(status, player_.episode_return(), player_.steps(), static_cast<int64_t>(replay_.size()),
+                             !demo);
     }
     // One process: always the newest weights; none (0) for an episode the scripted offense played.
-    run_.record_episode(
-        {sr.status, ep_return, steps, 0, demo ? 0 : static_cast<uint64_t>(algorithm_->updates()), demo});
+    run_.record_episode({status, player_.episode_return(), player_.steps(), 0,
+                         demo ? 0 : static_cast<uint64_t>(algorithm_->updates()), demo});
     if (bar_) {
       bar_->update(algorithm_->updates());
     }
