@@ -1,7 +1,7 @@
 // The running episode's transitions, kept until it ends so that each can carry its discounted
 // Monte-Carlo return (the paper's mixed target, §4.3) before it goes to replay. One class for
-// every path that plays episodes into replay: `pamdp train` (app/trainer.cpp) and the actors
-// (actor/actor_loop.cpp).
+// every path that plays episodes into replay: the episode player (actor/episode_player.hpp) of
+// `pamdp train` and of the actors.
 //
 // Sized once for the env's longest episode; push(), compute_returns() and transition()
 // allocate nothing.
