@@ -381,7 +381,8 @@ void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   // The ended episode goes out now, in a partial batch if need be, as `pamdp train` puts each
   // episode into its replay when it ends. Held back until a batch filled, the rows of episodes a
   // few steps long reached the learner up to a batch's worth of steps late, and MP-DQN on Goal
-  // fell into shooting at once far more often (docs/results.md, "Goal on the cluster").
+  // fell into shooting at once far more often (docs/results.md, "Goal and Platform on the
+  // cluster").
   if (!batch.empty()) {
     send_batch(batch, wire::kReplayTable);
   }
