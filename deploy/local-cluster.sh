@@ -138,8 +138,10 @@ for ((i = 0; i < shards; i++)); do
     --snapshot "$run_dir/shard-$i.replay" "${peer_curve[@]}" >"$run_dir/logs/shard-$i.log" 2>&1 &
   pids+=($!)
 done
+# No --seed: each actor seeds its own random streams (episode starts, exploration) from the run's
+# seed mixed with the index the learner gives it, so they follow --set seed=S as the learner does.
 for ((i = 0; i < actors; i++)); do
-  "$bin" actor --join "$join" --seed $((1000 + i)) "${peer_curve[@]}" >"$run_dir/logs/actor-$i.log" 2>&1 &
+  "$bin" actor --join "$join" "${peer_curve[@]}" >"$run_dir/logs/actor-$i.log" 2>&1 &
   pids+=($!)
 done
 
