@@ -91,7 +91,9 @@ run_pair() {
       sleep 0.2
     done
     if kill -0 "$server" 2>/dev/null && ((stopping == 0)); then
-      "$bin" actor --join "$join" --server-port "$port" --seed $((1000 + i)) --name "hfo-actor-$i" \
+      # No --seed: the actor seeds its exploration from the run's seed and its index, as in
+      # deploy/local-cluster.sh; the server's --seed above decides the episodes' starts.
+      "$bin" actor --join "$join" --server-port "$port" --name "hfo-actor-$i" \
         "${security[@]}" >>"$log_dir/actor-$i.log" 2>&1 &
       actor=$!
       wait "$actor" || true
