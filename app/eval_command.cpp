@@ -393,7 +393,9 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--shot", opts->shot,
                   "the scripted offense's shot against a goalie: best-course (the best of nine courses), "
                   "bottom-post (always inside the bottom post) or bottom-side (inside the bottom post, dribbling "
-                  "toward that side and waiting longer for the shot from far out); default best-course, and with "
+                  "toward that side and waiting longer for the shot from far out), close-in (dribbling slowly to "
+                  "within 8 m, then the best course: the one for agent2d's goalie) or close-in-post (the same, "
+                  "shooting inside the bottom post); default best-course, and with "
                   "--agreement the checkpoint's exploration.demo_shot")
       ->transform(CLI::CheckedTransformer(shots, CLI::ignore_case));
   opts->sim.add_to(*cmd);

@@ -520,7 +520,9 @@ const Choices<std::string>& env_choices() {
 const Choices<hfo::ShotAim>& shot_aim_choices() {
   static const Choices<hfo::ShotAim> kChoices{{"best-course", hfo::ShotAim::kBestCourse},
                                               {"bottom-post", hfo::ShotAim::kBottomPost},
-                                              {"bottom-side", hfo::ShotAim::kBottomSide}};
+                                              {"bottom-side", hfo::ShotAim::kBottomSide},
+                                              {"close-in", hfo::ShotAim::kCloseIn},
+                                              {"close-in-post", hfo::ShotAim::kCloseInPost}};
   return kChoices;
 }
 
