@@ -43,6 +43,28 @@ double RecentEpisodes::mean_steps() const {
 TrainingRun::TrainingRun(RunSpec spec, Algorithm& algorithm, const Env& env, Env& eval_env)
     : spec_(std::move(spec)), algorithm_(algorithm), env_(env), eval_env_(eval_env) {}
 
+// A resume may change the config (`--set train.max_updates=…`). config.toml then gets the config
+// the run goes on with, so a later plain --resume continues with it too, and the one before is
+// kept beside it as config-before-<updates>.toml.
+void TrainingRun::record_resumed_config() {
+  const fs::path path = spec_.dir / "config.toml";
+  std::string before;
+  if (fs::exists(path)) {
+    const std::vector<uint8_t> bytes = read_file_bytes(path.string());
+    before.assign(bytes.begin(), bytes.end());
+  }
+  if (before == spec_.config_toml) {
+    return;
+  }
+  if (!before.empty()) {
+    const fs::path kept = spec_.dir / ("config-before-" + std::to_string(algorithm_.updates()) + ".toml");
+    write_file_atomically(kept.string(), before.data(), before.size());
+    log::info("{}: resumed with a changed config: config.toml now holds it; the one before is {}", spec_.role,
+              kept.string());
+  }
+  write_file_atomically(path.string(), spec_.config_toml.data(), spec_.config_toml.size());
+}
+
 CheckpointMeta TrainingRun::start(bool resume) {
   fs::create_directories(spec_.dir);
   CheckpointMeta meta;
@@ -51,6 +73,7 @@ CheckpointMeta TrainingRun::start(bool resume) {
     episodes_ = meta.episodes;
     env_steps_ = meta.env_steps;
     base_seconds_ = meta.elapsed_seconds;
+    record_resumed_config();
   } else {
     if (!spec_.loop.init_from.empty()) {
       warm_start_from_checkpoint(spec_.loop.init_from, algorithm_);

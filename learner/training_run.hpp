@@ -110,6 +110,8 @@ class TrainingRun {
   // A new run (resume false) or one resumed from dir/checkpoint.ckpt. Returns the checkpoint's
   // metadata (default for a new run): the caller restores its own state from it (random streams,
   // fractional update credit, weights version). Throws std::runtime_error naming the file.
+  // Either way dir/config.toml ends up holding spec.config_toml; a resume that changed it keeps
+  // the earlier one as config-before-<updates>.toml.
   CheckpointMeta start(bool resume);
 
   // Fills in the caller's part of every checkpoint's metadata (checkpoint.ckpt and best.ckpt):
@@ -161,6 +163,7 @@ class TrainingRun {
 
  private:
   [[nodiscard]] CheckpointMeta meta_now();
+  void record_resumed_config();
   void save_to(const std::filesystem::path& file);
 
   RunSpec spec_;

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -197,6 +198,33 @@ TEST(TrainingRun, AKeepingResumeCountsTheEpisodesAfterItsCheckpoint) {
     last = line;
   }
   EXPECT_EQ(last.substr(0, 2), "4,");
+  fs::remove_all(dir);
+}
+
+std::string text_of(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(TrainingRun, AResumeThatChangesTheConfigRecordsItAndKeepsTheOneBefore) {
+  const fs::path dir = fresh_dir("config");
+  Learner l;
+  run_past_a_checkpoint(dir, l);  // checkpoint at 3 updates, config "seed = 7\n"
+  ASSERT_EQ(text_of(dir / "config.toml"), "seed = 7\n");
+  {
+    Learner same;
+    TrainingRun resumed(spec_in(dir, false), same.ddpg, same.env, same.eval_env);
+    resumed.start(true);
+    EXPECT_EQ(text_of(dir / "config.toml"), "seed = 7\n");
+    EXPECT_FALSE(fs::exists(dir / "config-before-3.toml"));  // nothing changed, nothing kept
+  }
+  Learner again;
+  RunSpec changed = spec_in(dir, false);
+  changed.config_toml = "seed = 7\n\n[train]\nmax_updates = 99\n";
+  TrainingRun resumed(changed, again.ddpg, again.env, again.eval_env);
+  resumed.start(true);
+  EXPECT_EQ(text_of(dir / "config.toml"), changed.config_toml);
+  EXPECT_EQ(text_of(dir / "config-before-3.toml"), "seed = 7\n");
   fs::remove_all(dir);
 }
 
