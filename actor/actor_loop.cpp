@@ -353,8 +353,8 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
 
 void ActorLoop::Impl::reset(EnvSlot& slot) {
   const ExplorationConfig& x = config.exploration;
-  slot.player.begin(mix_seeds(slot.seed, slot.episodes), demo_share(updates, x.demo_fraction, x.demo_anneal_updates),
-                    explore.rng());
+  slot.player.begin(mix_seeds(slot.seed, slot.episodes),
+                    demo_share(updates, x.demo_fraction, x.demo_anneal_updates, x.demo_fraction_end), explore.rng());
 }
 
 void ActorLoop::Impl::step(EnvSlot& slot) {

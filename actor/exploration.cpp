@@ -15,11 +15,11 @@ double linear_epsilon(int64_t updates, double start, double end, int64_t anneal)
   return start + (end - start) * frac;
 }
 
-double demo_share(int64_t updates, double fraction, int64_t anneal) {
+double demo_share(int64_t updates, double fraction, int64_t anneal, double end) {
   if (anneal <= 0) {
     return fraction;
   }
-  return linear_epsilon(updates, fraction, 0.0, anneal);
+  return linear_epsilon(updates, fraction, end, anneal);
 }
 
 int write_teacher_output(const ActionSpace& space, const ParamAction& a, std::span<const float> fill,

@@ -37,12 +37,13 @@ struct ExplorationConfig {
   // range (0: none, the paper's pure ε-greedy).
   double param_noise = 0.0;
   // Demonstrations (pamdp train, HFO only): the share of episodes the scripted offense plays
-  // instead of the actor, falling linearly to 0 over demo_anneal_updates learner updates (0:
-  // constant). Their transitions go to replay like any other; the stored action is the scripted
-  // one (score 1 for its action, -1 for the others, its parameters; the parameters of the other
-  // actions are the actor's own output).
+  // instead of the actor, falling linearly to demo_fraction_end over demo_anneal_updates learner
+  // updates and staying there (anneal 0: demo_fraction throughout). Their transitions go to replay like any other; the
+  // stored action is the scripted one (score 1 for its action, -1 for the others, its parameters; the parameters of the
+  // other actions are the actor's own output).
   double demo_fraction = 0.0;
   int64_t demo_anneal_updates = 0;
+  double demo_fraction_end = 0.0;  // the share kept after the anneal (0: the teacher stops)
   // With cloning (ddpg.demo_bc_weight > 0): the agent's own steps also go into the cloning
   // memory, each labelled with the scripted offense's action for the same state (DAgger), so the
   // agent is taught in the states it reaches, not only in those its teacher does.
@@ -50,7 +51,7 @@ struct ExplorationConfig {
 };
 
 // The demonstration share after `updates` learner updates (see ExplorationConfig).
-double demo_share(int64_t updates, double fraction, int64_t anneal);
+double demo_share(int64_t updates, double fraction, int64_t anneal, double end = 0.0);
 
 // A teacher's action as the actor's output vector carries it (a demonstration's stored action, or
 // a teacher's label): score 1 for its action and -1 for the others, its parameters, and `fill`

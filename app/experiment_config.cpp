@@ -100,6 +100,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.boolean("exploration.uniform_random_params", c.exploration.uniform_random_params);
   v.real("exploration.demo_fraction", c.exploration.demo_fraction, 0.0, 1.0);
   v.integer("exploration.demo_anneal_updates", c.exploration.demo_anneal_updates, 0, INT64_MAX);
+  v.real("exploration.demo_fraction_end", c.exploration.demo_fraction_end, 0.0, 1.0);
   v.boolean("exploration.demo_relabel", c.exploration.demo_relabel);
   v.choice("exploration.demo_shot", c.demo_shot, shot_aim_choices());
 
@@ -461,6 +462,17 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              ": exploration.demo_fraction > 0 needs the scripted offense, which reads the embedded "
                              "HFO features: use " +
                              envs_giving_embedded_features() + ", or set exploration.demo_fraction = 0");
+  }
+  if (c.exploration.demo_fraction_end > c.exploration.demo_fraction) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_fraction_end is the share the teacher's episodes fall to, and it is "
+                             "above exploration.demo_fraction: set it at or below demo_fraction");
+  }
+  if (c.exploration.demo_fraction_end > 0.0 && c.exploration.demo_anneal_updates <= 0) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_fraction_end is the share after the anneal, and "
+                             "exploration.demo_anneal_updates = 0 keeps demo_fraction throughout: set "
+                             "demo_anneal_updates > 0, or demo_fraction_end = 0");
   }
   if (c.ddpg.demo_bc_weight > 0.0 && c.exploration.demo_fraction <= 0.0) {
     throw std::runtime_error(src +

@@ -192,7 +192,8 @@ TrainSummary Trainer::run() {
     // One episode. The demonstration draw is skipped when demonstrations are off, so runs
     // without them keep their streams.
     player_.begin(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())),
-                  demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates),
+                  demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates,
+                             exploration_.demo_fraction_end),
                   explore_.rng());
     int status = 0;
     do {

@@ -115,6 +115,11 @@ TEST(Exploration, EpsilonSchedules) {
   EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100), 0.25);
   EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100), 0.0);
   EXPECT_DOUBLE_EQ(demo_share(5000, 0.5, 100), 0.0);
+  // With a floor (exploration.demo_fraction_end): linear down to it, then kept.
+  EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100, 0.1), 0.3);
+  EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100, 0.1), 0.1);
+  EXPECT_DOUBLE_EQ(demo_share(5000, 0.5, 100, 0.1), 0.1);
+  EXPECT_DOUBLE_EQ(demo_share(5000, 0.3, 0, 0.1), 0.3);
 }
 
 TEST(Exploration, RandomActionsFollowThePaper) {
@@ -1147,6 +1152,10 @@ TEST(Config, ErrorsNameTheKeyAndTheChoices) {
   expect_error("[exploration]\ndemo_shot = 'corner'\n", {}, "best-course, bottom-post");
   expect_error("[exploration]\ndemo_shot = 'bottom-post'\n", {},
                "exploration.demo_shot aims the scripted offense's shots, and it plays no episodes");
+  expect_error("[exploration]\ndemo_fraction = 0.1\ndemo_anneal_updates = 100\ndemo_fraction_end = 0.2\n", {},
+               "exploration.demo_fraction_end is the share the teacher's episodes fall to, and it is above");
+  expect_error("[exploration]\ndemo_fraction = 0.5\ndemo_fraction_end = 0.1\n", {},
+               "exploration.demo_anneal_updates = 0 keeps demo_fraction throughout");
 }
 
 TEST(Config, UpdateDevice) {
