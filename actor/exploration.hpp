@@ -51,7 +51,7 @@ struct ExplorationConfig {
 };
 
 // The demonstration share after `updates` learner updates (see ExplorationConfig).
-double demo_share(int64_t updates, double fraction, int64_t anneal, double end = 0.0);
+double demo_share(int64_t updates, double fraction, int64_t anneal, double end);
 
 // A teacher's action as the actor's output vector carries it (a demonstration's stored action, or
 // a teacher's label): score 1 for its action and -1 for the others, its parameters, and `fill`

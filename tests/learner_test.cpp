@@ -110,11 +110,11 @@ TEST(Exploration, EpsilonSchedules) {
   EXPECT_NEAR(apex_epsilon(7, 8), 0.00065536, 1e-12);
   EXPECT_DOUBLE_EQ(apex_epsilon(0, 1), 0.4);
   // Demonstrations: constant without an anneal, else linear down to 0.
-  EXPECT_DOUBLE_EQ(demo_share(123456, 0.3, 0), 0.3);
-  EXPECT_DOUBLE_EQ(demo_share(0, 0.5, 100), 0.5);
-  EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100), 0.25);
-  EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100), 0.0);
-  EXPECT_DOUBLE_EQ(demo_share(5000, 0.5, 100), 0.0);
+  EXPECT_DOUBLE_EQ(demo_share(123456, 0.3, 0, 0.0), 0.3);
+  EXPECT_DOUBLE_EQ(demo_share(0, 0.5, 100, 0.0), 0.5);
+  EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100, 0.0), 0.25);
+  EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(demo_share(5000, 0.5, 100, 0.0), 0.0);
   // With a floor (exploration.demo_fraction_end): linear down to it, then kept.
   EXPECT_DOUBLE_EQ(demo_share(50, 0.5, 100, 0.1), 0.3);
   EXPECT_DOUBLE_EQ(demo_share(100, 0.5, 100, 0.1), 0.1);
