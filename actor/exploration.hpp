@@ -38,9 +38,9 @@ struct ExplorationConfig {
   double param_noise = 0.0;
   // Demonstrations (pamdp train, HFO only): the share of episodes the scripted offense plays
   // instead of the actor, falling linearly to demo_fraction_end over demo_anneal_updates learner
-  // updates and staying there (anneal 0: demo_fraction throughout). Their transitions go to replay like any other; the
-  // stored action is the scripted one (score 1 for its action, -1 for the others, its parameters; the parameters of the
-  // other actions are the actor's own output).
+  // updates and staying there (anneal 0: demo_fraction throughout). Their transitions go to
+  // replay like any other; the stored action is the scripted one (score 1 for its action, -1 for
+  // the others, its parameters; the parameters of the other actions are the actor's own output).
   double demo_fraction = 0.0;
   int64_t demo_anneal_updates = 0;
   double demo_fraction_end = 0.0;  // the share kept after the anneal (0: the teacher stops)
