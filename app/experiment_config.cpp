@@ -72,6 +72,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("ddpg.clip_grad_norm", c.ddpg.clip_grad_norm, 0.0, 1e12);
   v.choice("ddpg.bound", c.ddpg.bound, kBounds);
   v.real("ddpg.mc_mix", c.ddpg.mc_mix, 0.0, 1.0);
+  v.real("ddpg.bootstrap_clip", c.ddpg.bootstrap_clip, 0.0, 1e12);
   v.integer("ddpg.lr_decay_updates", c.ddpg.lr_decay_updates, 0, INT64_MAX);
   v.real("ddpg.lr_final_fraction", c.ddpg.lr_final_fraction, 0.0, 1.0);
   v.real("ddpg.init_std", c.ddpg.init_std, 0.0, 10.0);

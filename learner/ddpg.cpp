@@ -143,8 +143,10 @@ UpdateStats Ddpg::update(const BatchView& batch, const BatchView* demos) {
   const auto q_next = target_critic_.forward(critic_in_.leftCols(B));
   const auto g = static_cast<float>(config_.gamma);
   const auto beta = static_cast<float>(config_.mc_mix);
+  const auto clip = static_cast<float>(config_.bootstrap_clip);
   for (int j = 0; j < B; ++j) {
-    float y = batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * q_next(0, j));
+    const float next = clip > 0.0F ? std::clamp(q_next(0, j), -clip, clip) : q_next(0, j);
+    float y = batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * next);
     if (beta > 0.0F) {
       y = beta * batch.mc_returns(j) + (1.0F - beta) * y;
     }

@@ -43,6 +43,12 @@ struct DdpgConfig {
   double clip_grad_norm = 10.0;  // global L2 norm per network; <= 0 disables
   BoundMethod bound = BoundMethod::kInverting;
   double mc_mix = 0.0;  // beta: y = beta * MC return + (1 - beta) * TD target
+  // The target networks' value of the next state, Q'(s', mu'(s')), is clamped to [-c, c] before
+  // it enters y; 0 disables. The target critic can rate the target actor's action far above
+  // any return in the data (it extrapolates where no stored action lies), and that value then
+  // feeds itself through the targets: a bound above the largest return an episode can earn
+  // stops the loop without touching a target that lies inside it (docs/learning.md).
+  double bootstrap_clip = 0.0;
   // Both learning rates fall linearly from their value to lr_final_fraction of it over the
   // first lr_decay_updates updates, then stay there; 0 keeps them constant (the paper).
   int64_t lr_decay_updates = 0;

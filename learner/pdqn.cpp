@@ -233,12 +233,16 @@ void Pdqn::targets(const BatchView& batch, int B) {
   const auto g = static_cast<float>(config_.gamma);
   const auto beta = static_cast<float>(config_.mc_mix);
   const auto scale = static_cast<float>(settings_.reward_scale);
+  const auto clip = static_cast<float>(config_.bootstrap_clip);
   for (int j = 0; j < B; ++j) {
     float best = -std::numeric_limits<float>::infinity();
     for (int k = 0; k < num_actions_; ++k) {
       if (!masked_[static_cast<size_t>(k)]) {
         best = std::max(best, q_of(q_next, k, j, B));
       }
+    }
+    if (clip > 0.0F) {
+      best = std::clamp(best, -clip, clip);
     }
     float y = scale * batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * best);
     if (beta > 0.0F) {

@@ -378,6 +378,38 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   EXPECT_EQ(d.updates(), 1);
 }
 
+// ddpg.bootstrap_clip: a critic whose output layer is all bias (its weights zeroed) rates every
+// (s, a) at that bias, so Q'(s', mu'(s')) is known exactly and each target can be computed by
+// hand.
+TEST(Ddpg, BootstrapClipBoundsTheTargetNetworksValue) {
+  toy::ReachStopEnv env;
+  BatchBuffers b(3, 3, 4);
+  Rng rng(2);
+  for (auto* v : {&b.states, &b.actions, &b.next_states}) {
+    for (float& x : *v) {
+      x = static_cast<float>(rng.uniform(-1, 1));
+    }
+  }
+  b.rewards = {1, 0, -1, 0.5F};
+  b.terminal = {0, 1, 0, 0};
+  const auto target_mean = [&](float bias, double clip) {
+    DdpgConfig c = tiny_config();
+    c.gamma = 0.9;
+    c.critic_output_init_bias = bias;
+    c.bootstrap_clip = clip;
+    Ddpg d(3, env.action_space(), c, 5);
+    for (Mlp<float>* net : {&d.critic(), &d.target_critic()}) {
+      net->weight(net->num_layers() - 1).setZero();
+    }
+    return d.update(view_of(b, 4)).target_mean;
+  };
+  // y = r + 0.9 * clamp(Q', -c, c) after the three non-terminal samples, r after the terminal.
+  EXPECT_NEAR(target_mean(100.0F, 2.0), (2.8 + 0.0 + 0.8 + 2.3) / 4.0, 1e-6);
+  EXPECT_NEAR(target_mean(-100.0F, 2.0), (-0.8 + 0.0 - 2.8 - 1.3) / 4.0, 1e-6);
+  EXPECT_NEAR(target_mean(100.0F, 0.0), (91.0 + 0.0 + 89.0 + 90.5) / 4.0, 1e-5);     // off
+  EXPECT_NEAR(target_mean(100.0F, 1000.0), (91.0 + 0.0 + 89.0 + 90.5) / 4.0, 1e-5);  // inside the bound
+}
+
 // The evaluation average: it starts as the actor, moves by 1 - (1 - tau)^k toward it over k
 // updates (one call or k calls alike while the actor holds still), stands still without new
 // updates or with tau = 0, and act(kAverage) plays it.

@@ -396,6 +396,30 @@ TEST(Pdqn, RewardScaleScalesTheTarget) {
   EXPECT_GT(std::abs(plain.losses(b.view()).q_loss - want), 1e-3);  // the scale matters here
 }
 
+// ddpg.bootstrap_clip bounds max_k Q'(s', k, x'(s')): with the Q-networks' output weights zeroed
+// every output is the bias B, and the Q loss
+// is (1 / 2B) sum (B - y)^2 with y = r + 0.9 * clamp(B, -c, c) (r after the terminal sample).
+TEST(Pdqn, BootstrapClipBoundsTheTargetNetworksValue) {
+  const ActionSpace space = test_space();
+  const Batch b;
+  for (const double clip : {0.0, 2.0, 1000.0}) {
+    DdpgConfig config = small(BoundMethod::kInverting);
+    config.critic_output_init_bias = 100.0;
+    config.bootstrap_clip = clip;
+    Pdqn pdqn(kObs, space, config, 5, true);
+    for (Mlp<float>* net : {&pdqn.q_net(), &pdqn.target_q_net()}) {
+      net->weight(net->num_layers() - 1).setZero();
+    }
+    const double next = clip > 0.0 && clip < 100.0 ? clip : 100.0;
+    double want = 0.0;
+    for (int j = 0; j < kB; ++j) {
+      const double y = b.rewards(j) + (b.terminal(j) > 0.5F ? 0.0 : 0.9 * next);
+      want += 0.5 * (100.0 - y) * (100.0 - y) / kB;
+    }
+    EXPECT_NEAR(pdqn.losses(b.view()).q_loss, want, 1e-4 * want) << clip;
+  }
+}
+
 // pdqn.q_tau and pdqn.param_tau move each target network at its own rate.
 TEST(Pdqn, EachNetworkHasItsOwnTargetRate) {
   const ActionSpace space = test_space();

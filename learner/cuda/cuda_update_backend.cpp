@@ -90,6 +90,7 @@ cuda::DeviceDdpgConfig device_config(Ddpg& ddpg) {
   }
   d.gamma = static_cast<float>(c.gamma);
   d.mc_mix = static_cast<float>(c.mc_mix);
+  d.bootstrap_clip = static_cast<float>(c.bootstrap_clip);
   d.tau = static_cast<float>(c.tau);
   d.one_minus_tau = static_cast<float>(1.0 - c.tau);
   d.clip_grad_norm = c.clip_grad_norm;

@@ -225,14 +225,15 @@ __device__ double block_sum(double x, double* shared) {
 // the loss, mean Q and mean target (Ddpg::update steps 1 and 2).
 __global__ void critic_loss_kernel(const float* __restrict__ q_next, const float* __restrict__ q,
                                    const float* __restrict__ rewards, const float* __restrict__ terminal,
-                                   const float* __restrict__ mc_returns, int batch, float gamma, float beta,
+                                   const float* __restrict__ mc_returns, int batch, float gamma, float beta, float clip,
                                    float* __restrict__ d_q, float* __restrict__ stats) {
   __shared__ double shared[kThreads];
   double loss = 0.0;
   double q_sum = 0.0;
   double y_sum = 0.0;
   for (int j = threadIdx.x; j < batch; j += kThreads) {
-    float y = rewards[j] + (terminal[j] > 0.5F ? 0.0F : gamma * q_next[j]);
+    const float next = clip > 0.0F ? fminf(fmaxf(q_next[j], -clip), clip) : q_next[j];
+    float y = rewards[j] + (terminal[j] > 0.5F ? 0.0F : gamma * next);
     if (beta > 0.0F) {
       y = beta * mc_returns[j] + (1.0F - beta) * y;
     }
@@ -723,7 +724,7 @@ struct Impl {
     check(cudaStreamWaitEvent(main.stream, targets_done, 0), "cudaStreamWaitEvent");
     critic_loss_kernel<<<1, kThreads, 0, main.stream>>>(pass_target_critic.out.get(), pass_critic.out.get(),
                                                         in + off_rewards, in + off_terminal, in + off_returns, B,
-                                                        c.gamma, c.mc_mix, d_q.get(), stats.get());
+                                                        c.gamma, c.mc_mix, c.bootstrap_clip, d_q.get(), stats.get());
     check_launch("critic_loss_kernel");
     backward(critic, critic_in_batch.get(), pass_critic, d_q.get(), true, 0, 0, nullptr);
     optimizer_step(critic, in + kCriticStep, stats.get() + kStatCriticNorm);

@@ -29,6 +29,7 @@ struct DeviceDdpgConfig {
   float leaky_slope = 0.01F;
   float gamma = 0.99F;
   float mc_mix = 0.0F;
+  float bootstrap_clip = 0.0F;  // <= 0: Q'(s', mu'(s')) enters the target unclamped
   float tau = 1e-4F;            // as soft_update<float> casts it
   float one_minus_tau = 1.0F;   // float(1.0 - tau), likewise
   double clip_grad_norm = 0.0;  // <= 0: no clipping
