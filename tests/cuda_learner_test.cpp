@@ -324,6 +324,38 @@ TEST(CudaLearner, OneUpdateWithMonteCarloMix) {
   EXPECT_LE(relative_error(cpu.critic_optimizer().first_moment(), gpu.critic_optimizer().first_moment()), kMomentRel1);
 }
 
+// ddpg.bootstrap_clip on the device: a critic rating everything at 100 (output weights zeroed)
+// with the clip at 2 gives the CPU's targets, and the clip binds (the unclipped mean is far off).
+TEST(CudaLearner, OneUpdateWithBootstrapClip) {
+  if (const std::string why = no_device(); !why.empty()) {
+    GTEST_SKIP() << why;
+  }
+  const ActionSpace& space = hfo::hfo_action_space();
+  DdpgConfig c = config(BoundMethod::kInverting);
+  c.critic_output_init_bias = 100.0;
+  c.bootstrap_clip = 2.0;
+  DdpgConfig off = c;
+  off.bootstrap_clip = 0.0;
+  Ddpg cpu(kObs, space, c, 13);
+  Ddpg gpu(kObs, space, c, 13);
+  Ddpg unclipped(kObs, space, off, 13);
+  for (Ddpg* d : {&cpu, &gpu, &unclipped}) {
+    for (Mlp<float>* net : {&d->critic(), &d->target_critic()}) {
+      net->weight(net->num_layers() - 1).setZero();
+    }
+  }
+  const auto backend = make_update_backend(gpu, UpdateDevice::kCuda);
+  const Batches data(cpu.bounds(), 1, kBatch, 7);
+  const UpdateStats cs = cpu.update(data.view(0));
+  const UpdateStats us = unclipped.update(data.view(0));
+  backend->update(data.view(0));
+  const UpdateStats gs = backend->finish();
+  expect_stat("target_mean", cs.target_mean, gs.target_mean, kStatsRel1);
+  expect_stat("critic_loss", cs.critic_loss, gs.critic_loss, kStatsRel1);
+  EXPECT_LT(cs.target_mean, 3.0F);
+  EXPECT_GT(us.target_mean, 50.0F);
+}
+
 // Statistics lag one update (the update runs asynchronously); finish() returns the newest.
 TEST(CudaLearner, StatisticsOfThePreviousUpdate) {
   if (const std::string why = no_device(); !why.empty()) {
