@@ -355,11 +355,9 @@ DdpgConfig tiny_config() {
   return c;
 }
 
-TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
-  toy::ReachStopEnv env;
-  Ddpg d(3, env.action_space(), tiny_config(), 5);
-  const std::vector<float> actor_before(d.actor().params().begin(), d.actor().params().end());
-  ASSERT_TRUE(std::equal(actor_before.begin(), actor_before.end(), d.target_actor().params().begin()));
+// Four ReachStop-shaped transitions (3 observations, 3 outputs) with states and actions drawn
+// in [-1, 1], rewards 1, 0, -1, 0.5, the second one terminal.
+BatchBuffers four_transitions() {
   BatchBuffers b(3, 3, 4);
   Rng rng(2);
   for (auto* v : {&b.states, &b.actions, &b.next_states}) {
@@ -369,6 +367,15 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
   }
   b.rewards = {1, 0, -1, 0.5F};
   b.terminal = {0, 1, 0, 0};
+  return b;
+}
+
+TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
+  toy::ReachStopEnv env;
+  Ddpg d(3, env.action_space(), tiny_config(), 5);
+  const std::vector<float> actor_before(d.actor().params().begin(), d.actor().params().end());
+  ASSERT_TRUE(std::equal(actor_before.begin(), actor_before.end(), d.target_actor().params().begin()));
+  const BatchBuffers b = four_transitions();
   d.update(view_of(b, 4));
   // theta' = tau theta_new + (1 - tau) theta_old, with theta_old the initial copy.
   for (size_t i = 0; i < actor_before.size(); ++i) {
@@ -383,15 +390,7 @@ TEST(Ddpg, TargetsStartEqualAndMoveByTau) {
 // hand.
 TEST(Ddpg, BootstrapClipBoundsTheTargetNetworksValue) {
   toy::ReachStopEnv env;
-  BatchBuffers b(3, 3, 4);
-  Rng rng(2);
-  for (auto* v : {&b.states, &b.actions, &b.next_states}) {
-    for (float& x : *v) {
-      x = static_cast<float>(rng.uniform(-1, 1));
-    }
-  }
-  b.rewards = {1, 0, -1, 0.5F};
-  b.terminal = {0, 1, 0, 0};
+  const BatchBuffers b = four_transitions();
   const auto target_mean = [&](float bias, double clip) {
     DdpgConfig c = tiny_config();
     c.gamma = 0.9;

@@ -397,8 +397,8 @@ TEST(Pdqn, RewardScaleScalesTheTarget) {
 }
 
 // ddpg.bootstrap_clip bounds max_k Q'(s', k, x'(s')): with the Q-networks' output weights zeroed
-// every output is the bias B, and the Q loss
-// is (1 / 2B) sum (B - y)^2 with y = r + 0.9 * clamp(B, -c, c) (r after the terminal sample).
+// every output is the bias B, and the Q loss is (1 / 2B) sum (B - y)^2 with
+// y = r + 0.9 * clamp(B, -c, c) (r after the terminal sample).
 TEST(Pdqn, BootstrapClipBoundsTheTargetNetworksValue) {
   const ActionSpace space = test_space();
   const Batch b;
