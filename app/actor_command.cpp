@@ -22,6 +22,7 @@
 #include "core/log.hpp"
 #include "core/transport.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/settings.hpp"
 #include "envs/registry.hpp"
 
 namespace pamdp::app {
@@ -129,7 +130,10 @@ void run_actor(const ActorCliOptions& o) {
   if (config.exploration.demo_fraction > 0.0) {
     // The learner's config was checked: demonstrations come with an env the scripted offense reads.
     const hfo::ShotAim shot = config.demo_shot;
-    loop_config.make_teacher = [shot] { return std::make_unique<hfo::ScriptedOffense>(shot); };
+    const bool shoot_action = hfo::shoot_action(config.env.params);
+    loop_config.make_teacher = [shot, shoot_action] {
+      return std::make_unique<hfo::ScriptedOffense>(shot, shoot_action);
+    };
   }
   loop_config.demo_table = config.ddpg.demo_bc_weight > 0.0;
 

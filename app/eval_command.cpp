@@ -281,7 +281,8 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
                                o.checkpoint + " plays env '" + c.env.name +
                                "' (use a checkpoint trained on hfo, or leave out --agreement)");
     }
-    hfo::ScriptedOffense offense(shot_given ? o.shot : c.demo_shot);  // by default the teacher it learned from
+    hfo::ScriptedOffense offense(shot_given ? o.shot : c.demo_shot,
+                                 hfo::shoot_action(c.env.params));  // by default the teacher it learned from
     PolicyAgreement tally(env->action_space());
     Shadowed shadowed(offense, policy, tally);
     print_result("scripted", evaluate_with_progress(std::move(env), shadowed, o), o.json, &tally, o.checkpoint);
@@ -335,7 +336,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   auto env = make_env(c.env);
   std::unique_ptr<Policy> policy;
   if (o.policy == "scripted") {
-    policy = std::make_unique<hfo::ScriptedOffense>(o.shot);
+    policy = std::make_unique<hfo::ScriptedOffense>(o.shot, hfo::shoot_action(c.env.params));
   } else if (hfo_actions) {
     // The paper's exploration draw: Tackle masked, dash power U[-100, 100] (reference §7.3).
     auto random = std::make_unique<RandomPolicy>(env->action_space(), o.seed ^ 0x5eedULL,

@@ -20,6 +20,7 @@
 #include "app/run_support.hpp"
 #include "core/log.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/settings.hpp"
 #include "learner/algorithm.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/sampler.hpp"
@@ -47,7 +48,7 @@ class Trainer {
         algorithm_(make_learner(c, obs_dim_, space_, mix_seeds(c.seed, 1))),
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
-        demo_(c.demo_shot),
+        demo_(c.demo_shot, hfo::shoot_action(c.env.params)),
         sample_rng_(mix_seeds(c.seed, 3)),
         player_(*env_, &demo_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
         act_([this](std::span<const float> obs, std::span<float> out) { algorithm_->act(obs, out); }),

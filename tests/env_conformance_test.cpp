@@ -39,11 +39,11 @@ void PrintTo(const EnvCase& c, std::ostream* os) {
   *os << c.name;
 }
 
-std::unique_ptr<Env> make_hfo(bool noise, bool goalie = false) {
+std::unique_ptr<Env> make_hfo(bool noise, bool goalie = false, bool shoot_action = false) {
   hfo::SoccerSimConfig config;
   config.noise = noise;
   config.goalie = goalie;
-  return std::make_unique<hfo::HfoEnv>(config);
+  return std::make_unique<hfo::HfoEnv>(config, shoot_action);
 }
 
 const EnvCase kHandCases[] = {
@@ -51,6 +51,7 @@ const EnvCase kHandCases[] = {
     {"HfoNoNoise", [] { return make_hfo(false); }, hfo::kNumAgentFeatures, 1.0F, 30},
     {"HfoGoalieNoise", [] { return make_hfo(true, true); }, hfo::feature_count(2), 1.0F, 30},
     {"HfoGoalieNoNoise", [] { return make_hfo(false, true); }, hfo::feature_count(2), 1.0F, 30},
+    {"HfoGoalieShootAction", [] { return make_hfo(true, true, true); }, hfo::feature_count(2), 1.0F, 30},
     {"ReachStop", [] { return std::make_unique<toy::ReachStopEnv>(); }, toy::ReachStopEnv::kObservationSize,
      toy::ReachStopEnv::kObservationBound, 200},
 };

@@ -438,5 +438,64 @@ TEST(HfoGoalie, CloseInScoresAgainstAgent2dsGoalie) {
   EXPECT_GE(in.avg_steps_to_goal, 110.0) << to_json(in);
 }
 
+// env.shoot_action adds SHOOT, a kick with parameters of its own (hfo_env.hpp). The close-in
+// offense then shoots with SHOOT and dribbles with KICK, and the game is the same step for step:
+// two envs on the same starts, one with SHOOT and one without, see the same features after every
+// action, the SHOOT of the one being the other's full-power KICK.
+TEST(HfoGoalie, ShootActionIsTheSameKickUnderItsOwnName) {
+  SoccerSimConfig c = goalie_config(true);
+  c.start = StartDistribution::kHfo;
+  HfoEnv with(c, true);
+  HfoEnv without(c);
+  ASSERT_EQ(without.action_space().num_actions(), 4);
+  ASSERT_EQ(with.action_space().num_actions(), 5);
+  ASSERT_EQ(with.action_space().num_params(), param::kCountWithShoot);
+  EXPECT_EQ(with.action_space().actions[kShoot].name, "SHOOT");
+  EXPECT_EQ(with.action_space().params[param::kShootPower].name, "shoot_power");
+  EXPECT_EQ(with.action_space().find_action("KICK"), kKick);
+  ScriptedOffense shooter(ShotAim::kCloseIn, true);
+  ScriptedOffense kicker(ShotAim::kCloseIn);
+  std::vector<float> a(static_cast<size_t>(with.observation_size()));
+  std::vector<float> b(a.size());
+  int shots = 0;
+  int goals = 0;
+  int soft_kicks = 0;
+  for (uint64_t episode = 0; episode < 40; ++episode) {
+    with.reset(100 + episode, a);
+    without.reset(100 + episode, b);
+    for (int step = 0; step < 500; ++step) {
+      ASSERT_EQ(a, b) << "episode " << episode << " step " << step;
+      const ParamAction s = shooter.act(a);
+      const ParamAction k = kicker.act(b);
+      ASSERT_EQ(s.params.size(), 8U);
+      ASSERT_EQ(k.params.size(), 6U);
+      if (s.id == kShoot) {
+        ASSERT_EQ(k.id, kKick);
+        EXPECT_EQ(s.params[param::kShootPower], 100.0F);
+        EXPECT_EQ(s.params[param::kShootPower], k.params[param::kKickPower]);
+        EXPECT_EQ(s.params[param::kShootDir], k.params[param::kKickDir]);
+        ++shots;
+      } else {
+        ASSERT_EQ(s.id, k.id);
+        if (s.id == kKick) {
+          EXPECT_LT(s.params[param::kKickPower], 100.0F);  // a dribbling touch
+          ++soft_kicks;
+        }
+      }
+      const StepResult rs = with.step(s, a);
+      const StepResult rk = without.step(k, b);
+      ASSERT_EQ(rs.status, rk.status);
+      ASSERT_EQ(rs.reward, rk.reward);
+      if (rs.status != kInGame) {
+        goals += rs.status == kGoal ? 1 : 0;
+        break;
+      }
+    }
+  }
+  EXPECT_GE(goals, 36);  // .993 on 1,000 starts
+  EXPECT_GE(shots, goals);
+  EXPECT_GE(soft_kicks, 40 * 20);
+}
+
 }  // namespace
 }  // namespace pamdp::hfo

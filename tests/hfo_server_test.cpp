@@ -304,6 +304,25 @@ TEST(HfoServerActions, OutOfRangeParametersAreClippedWrappedAndCounted) {
   EXPECT_EQ(counts.direction, 4);
 }
 
+// env.shoot_action's SHOOT is a kick with its own two parameters: the server gets KICK's
+// arguments from them, clipped and counted as a kick's are, and KICK's slots are not read.
+TEST(HfoServerActions, ShootSendsAKickFromItsOwnParameters) {
+  ActionClampCounts counts;
+  const auto args = [&](int id, std::array<float, 8> p) { return server_command_args({id, p}, counts); };
+  ServerCommandArgs a = args(hfo::kShoot, {0, 0, 0, 0, 3, -40, 100, 12.5F});
+  EXPECT_EQ(a.p1, 100.0);
+  EXPECT_EQ(a.p2, 12.5);
+  EXPECT_EQ(counts.total(), 0);
+  a = args(hfo::kShoot, {0, 0, 0, 0, 50, 0, 104, 190});
+  EXPECT_EQ(a.p1, 100.0);
+  EXPECT_NEAR(a.p2, -170.0, 1e-9);
+  EXPECT_EQ(counts.kick_power, 1);
+  EXPECT_EQ(counts.direction, 1);
+  a = args(hfo::kKick, {0, 0, 0, 0, 3, -40, 100, 12.5F});  // KICK still reads its own
+  EXPECT_EQ(a.p1, 3.0);
+  EXPECT_EQ(a.p2, -40.0);
+}
+
 // A UDP socket on 127.0.0.1 that answers every datagram from the `first_answered`-th on (1-based),
 // as rcssserver answers an unknown command; a server that is still starting answers none at first.
 class FakeServer {

@@ -858,6 +858,37 @@ TEST(Train, RelabellingPutsTheAgentsStatesWithTheScriptedActionsIntoTheCloningMe
   fs::remove_all(dir);
 }
 
+TEST(Train, WithTheShootActionTheTeachersShotsAreClonedAsShoot) {
+  // env.shoot_action: the network has a second kick, SHOOT, and the scripted offense's full-power
+  // shots are stored as SHOOT with their power and direction in SHOOT's own slots. On the empty
+  // goal every kick of the offense is such a shot, so no demonstrated step is a KICK.
+  const fs::path dir = fresh_dir("shoot");
+  app::ExperimentConfig c = hfo_demo_config(1.0, 20);
+  c.env.params.set("shoot_action", true);
+  c.ddpg.demo_bc_weight = 1.0;
+  app::train(c, {dir.string(), false, true, nullptr});
+  const hfo::HfoEnv env({}, true);
+  const ActionSpace& space = env.action_space();
+  ASSERT_EQ(space.num_actions(), 5);
+  const int obs = env.observation_size();
+  const int width = space.output_width();
+  ReplayBuffer demos(c.replay.capacity, obs, width);
+  load_replay_snapshot((dir / "demo_replay.bin").string(), demos);
+  ASSERT_GT(demos.size(), 0);
+  const int64_t row = 2LL * obs + width + 3;
+  int64_t shots = 0;
+  for (int64_t i = 0; i < demos.size(); ++i) {
+    const float* a = demos.raw().data() + i * row + obs;
+    ASSERT_EQ(a[hfo::kKick], -1.0F) << "row " << i << ": a shot stored as KICK";
+    if (a[hfo::kShoot] == 1.0F) {
+      ++shots;
+      EXPECT_EQ(a[space.num_actions() + hfo::param::kShootPower], 100.0F) << "row " << i;
+    }
+  }
+  EXPECT_GE(shots, 20);  // one shot or more in each of the 20 episodes
+  fs::remove_all(dir);
+}
+
 TEST(Train, ResumeIsBitForBit) {
   const fs::path a = fresh_dir("straight");
   const fs::path b = fresh_dir("halves");

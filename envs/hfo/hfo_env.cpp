@@ -15,7 +15,7 @@ namespace {
 
 }  // namespace
 
-const ActionSpace& hfo_action_space() {
+const ActionSpace& hfo_action_space(bool shoot) {
   static const ActionSpace kSpace{
       .actions = {{"DASH", {param::kDashPower, param::kDashDir}},
                   {"TURN", {param::kTurnDir}},
@@ -28,7 +28,14 @@ const ActionSpace& hfo_action_space() {
                  {"kick_power", 0.0F, 100.0F},
                  {"kick_dir", -180.0F, 180.0F}},
   };
-  return kSpace;
+  static const ActionSpace kWithShoot = [] {
+    ActionSpace s = kSpace;
+    s.actions.push_back({"SHOOT", {param::kShootPower, param::kShootDir}});
+    s.params.push_back({"shoot_power", 0.0F, 100.0F});
+    s.params.push_back({"shoot_dir", -180.0F, 180.0F});
+    return s;
+  }();
+  return shoot ? kWithShoot : kSpace;
 }
 
 ShapedReward::Snapshot ShapedReward::snapshot(std::span<const float> f) {
@@ -71,7 +78,7 @@ float ShapedReward::operator()(std::span<const float> features, int status) {
   return static_cast<float>(r);
 }
 
-HfoEnv::HfoEnv(const SoccerSimConfig& config) : sim_(config) {}
+HfoEnv::HfoEnv(const SoccerSimConfig& config, bool shoot_action) : sim_(config), shoot_(shoot_action) {}
 
 std::span<const int> HfoEnv::outcomes() const {
   static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
@@ -110,8 +117,9 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, const Pl
 }
 
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
-  if (action.params.size() < static_cast<size_t>(param::kCount)) {
-    misuse("step(): the parameter vector must hold the 6 HFO parameters");
+  if (action.params.size() < static_cast<size_t>(shoot_ ? param::kCountWithShoot : param::kCount)) {
+    misuse(shoot_ ? "step(): the parameter vector must hold the 8 HFO parameters (env.shoot_action)"
+                  : "step(): the parameter vector must hold the 6 HFO parameters");
   }
   if (episode_over_) {
     misuse("step() after a terminal status; call reset() first");
@@ -122,7 +130,13 @@ StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
     case kTurn: sim_.turn(p(param::kTurnDir)); break;
     case kTackle: sim_.tackle(p(param::kTackleDir)); break;
     case kKick: sim_.kick(p(param::kKickPower), p(param::kKickDir)); break;
-    default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
+    case kShoot:
+      if (!shoot_) {
+        misuse("step(): SHOOT (4) needs env.shoot_action");
+      }
+      sim_.kick(p(param::kShootPower), p(param::kShootDir));
+      break;
+    default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK, 4 SHOOT)");
   }
   const int status = sim_.step();
   episode_over_ = status != kInGame;

@@ -12,8 +12,9 @@
 
 namespace pamdp::hfo {
 
-// Discrete action ids (reference §4) and indices into the shared 6-parameter vector.
-enum ActionId : int { kDash = 0, kTurn = 1, kTackle = 2, kKick = 3 };
+// Discrete action ids (reference §4) and indices into the shared 6-parameter vector. kShoot
+// exists only with env.shoot_action (below).
+enum ActionId : int { kDash = 0, kTurn = 1, kTackle = 2, kKick = 3, kShoot = 4 };
 namespace param {
 inline constexpr int kDashPower = 0;
 inline constexpr int kDashDir = 1;
@@ -22,11 +23,20 @@ inline constexpr int kTackleDir = 3;
 inline constexpr int kKickPower = 4;
 inline constexpr int kKickDir = 5;
 inline constexpr int kCount = 6;
+inline constexpr int kShootPower = 6;  // with env.shoot_action
+inline constexpr int kShootDir = 7;
+inline constexpr int kCountWithShoot = 8;
 }  // namespace param
 
 // The paper's action space: DASH(power, dir), TURN(dir), TACKLE(dir), KICK(power, dir), with
 // the bounds the actor is kept in (reference §7.4 step 5).
-const ActionSpace& hfo_action_space();
+//
+// `shoot` (env.shoot_action) adds a fifth action, SHOOT(shoot_power, shoot_dir): the same kick
+// command with parameters of its own, so a network keeps two kicks apart, a soft touch to
+// dribble and a full-power shot, and the discrete choice between them switches at once where
+// one kick head would pass through the powers in between (docs/learning.md, "A second kick").
+// The server and the simulator see a KICK either way.
+const ActionSpace& hfo_action_space(bool shoot = false);
 
 // The shaped reward of dqn-hfo, computed from consecutive feature vectors (reference §6.2):
 // no shaping on the first transition of an episode nor on the terminal one, kickable bonus
@@ -53,10 +63,11 @@ class ShapedReward {
 
 class HfoEnv final : public Env {
  public:
-  explicit HfoEnv(const SoccerSimConfig& config = {});
+  // shoot_action: the action space with SHOOT (env.shoot_action).
+  explicit HfoEnv(const SoccerSimConfig& config = {}, bool shoot_action = false);
 
   [[nodiscard]] std::string_view name() const override { return "hfo"; }
-  [[nodiscard]] const ActionSpace& action_space() const override { return hfo_action_space(); }
+  [[nodiscard]] const ActionSpace& action_space() const override { return hfo_action_space(shoot_); }
   [[nodiscard]] int observation_size() const override { return feature_count(sim_.state().num_players); }
   [[nodiscard]] int max_episode_steps() const override { return sim_.config().max_steps + 1; }
   [[nodiscard]] std::string_view status_name(int status) const override { return hfo::status_name(status); }
@@ -78,6 +89,7 @@ class HfoEnv final : public Env {
 
   SoccerSim sim_;
   ShapedReward reward_;
+  bool shoot_ = false;
   bool episode_over_ = false;
 };
 

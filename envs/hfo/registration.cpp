@@ -61,6 +61,14 @@ EnvKey goalie_key() {
   return EnvKey::boolean("goalie", SoccerSimConfig{}.goalie);
 }
 
+EnvKey shoot_action_key() {
+  return EnvKey::boolean("shoot_action", false);
+}
+
+bool shoot_action(const EnvParams& params) {
+  return params.contains("shoot_action") && params.boolean("shoot_action");
+}
+
 EnvKey max_steps_key() {
   return EnvKey::integer("max_steps", SoccerSimConfig{}.max_steps, 1, 1000000);
 }
@@ -106,7 +114,10 @@ void register_hfo_env(EnvRegistry& registry) {
   r.name = "hfo";
   r.description = "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true)";
   r.keys = hfo::sim_keys();
-  r.make = [](const EnvParams& p) { return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p)); };
+  r.keys.push_back(hfo::shoot_action_key());
+  r.make = [](const EnvParams& p) {
+    return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p), p.boolean("shoot_action"));
+  };
   r.observation_size = [](const EnvParams& p) { return hfo::HfoEnv(hfo::sim_config(p)).observation_size(); };
   r.gives_embedded_hfo_features = [](const EnvParams&) { return true; };
   r.hfo_actions = true;

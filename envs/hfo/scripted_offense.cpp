@@ -80,16 +80,21 @@ ParamAction ScriptedOffense::act(std::span<const float> f) {
       return kick_against_goalie(f);
     }
     const double goal_deg = std::atan2(f[feat::kGoalCentre], f[feat::kGoalCentre + 1]) * kRadToDeg;
-    params_[param::kKickPower] = 100.0F;
-    params_[param::kKickDir] = static_cast<float>(goal_deg);
-    return {kKick, params_};
+    return shot(100.0, goal_deg);
   }
   if (std::fabs(ball_deg) > 10.0) {
     params_[param::kTurnDir] = static_cast<float>(ball_deg);
-    return {kTurn, params_};
+    return {kTurn, view()};
   }
   params_[param::kDashPower] = 100.0F;
-  return {kDash, params_};
+  return {kDash, view()};
+}
+
+ParamAction ScriptedOffense::shot(double power, double dir_deg) {
+  const bool own = shoot_action_;
+  params_[own ? param::kShootPower : param::kKickPower] = static_cast<float>(power);
+  params_[own ? param::kShootDir : param::kKickDir] = static_cast<float>(dir_deg);
+  return {own ? kShoot : kKick, view()};
 }
 
 ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
@@ -162,16 +167,14 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
   const bool close = to_goal <= rule.must_shoot_range;
   const double needed = rule.margin + rule.slope * (to_goal - kRuleDistance);
   if (best_margin >= needed || (close && best_margin > -1e9)) {
-    params_[param::kKickPower] = static_cast<float>(kMaxKickPower);
-    params_[param::kKickDir] = static_cast<float>(std::atan2(best_accel.y, best_accel.x) * kRadToDeg);
-    return {kKick, params_};
+    return shot(kMaxKickPower, std::atan2(best_accel.y, best_accel.x) * kRadToDeg);
   }
   // Dribble: the ball rolls toward the goal centre, or the rule's point toward the bottom post.
   const Vec2 target = goal + across * (rule.dribble_offset * 0.5 * mouth);
   const Vec2 accel = unit(target - ball) * rule.dribble_speed - vb;
   params_[param::kKickPower] = static_cast<float>(std::min(kMaxKickPower, accel.r() / rate));
   params_[param::kKickDir] = static_cast<float>(std::atan2(accel.y, accel.x) * kRadToDeg);
-  return {kKick, params_};
+  return {kKick, view()};
 }
 
 }  // namespace pamdp::hfo

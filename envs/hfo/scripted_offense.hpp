@@ -27,6 +27,8 @@
 // within 8 m of it. It scores .993 against that goalie here and .995 on the real server, where
 // the others score .13-.25 (3,000 episodes each; docs/results.md). ShotAim::kCloseInPost does the
 // same with the bottom post's course (.961 here, .965 real), a shot a network copies more easily.
+// With shoot_action (env.shoot_action) its shots are SHOOT, the second kick, and its dribbling
+// touches KICK; without it both are KICK.
 // act() allocates nothing; the policy keeps no state between steps.
 #pragma once
 
@@ -34,6 +36,7 @@
 #include <span>
 
 #include "core/policy.hpp"
+#include "envs/hfo/hfo_env.hpp"
 
 namespace pamdp::hfo {
 
@@ -41,14 +44,20 @@ enum class ShotAim { kBestCourse, kBottomPost, kBottomSide, kCloseIn, kCloseInPo
 
 class ScriptedOffense final : public Policy {
  public:
-  explicit ScriptedOffense(ShotAim aim = ShotAim::kBestCourse) : aim_(aim) {}
+  explicit ScriptedOffense(ShotAim aim = ShotAim::kBestCourse, bool shoot_action = false)
+      : aim_(aim), shoot_action_(shoot_action) {}
   ParamAction act(std::span<const float> obs) override;
 
  private:
   ParamAction kick_against_goalie(std::span<const float> obs);
+  ParamAction shot(double power, double dir_deg);  // a full-power shot: SHOOT, or KICK without it
+  [[nodiscard]] std::span<const float> view() const {
+    return {params_.data(), static_cast<size_t>(shoot_action_ ? param::kCountWithShoot : param::kCount)};
+  }
 
   ShotAim aim_;
-  std::array<float, 6> params_{};
+  bool shoot_action_;
+  std::array<float, param::kCountWithShoot> params_{};
 };
 
 }  // namespace pamdp::hfo

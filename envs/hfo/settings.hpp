@@ -21,6 +21,11 @@ const Names<BodyAtReset>& body_at_reset_names();  // carry, zero, uniform
 // The keys, with SoccerSimConfig's defaults.
 EnvKey goalie_key();
 EnvKey max_steps_key();
+// env.shoot_action: the action space with SHOOT, a second kick (hfo_env.hpp); read by hfo and
+// hfo-server alike, so a policy trained with it plays on the real server.
+EnvKey shoot_action_key();
+// Its value in `params`; false for an env without the key.
+bool shoot_action(const EnvParams& params);
 std::vector<EnvKey> sim_keys();  // every key of SoccerSimConfig, goalie and max_steps included
 
 // `params` holds every key of sim_keys() (EnvRegistry::defaults() does).

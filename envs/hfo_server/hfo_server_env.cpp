@@ -84,7 +84,7 @@ class HfoServerEnv final : public Env {
   }
 
   [[nodiscard]] std::string_view name() const override { return "hfo-server"; }
-  [[nodiscard]] const ActionSpace& action_space() const override { return hfo::hfo_action_space(); }
+  [[nodiscard]] const ActionSpace& action_space() const override { return hfo::hfo_action_space(c_.shoot_action); }
   [[nodiscard]] int observation_size() const override { return hfo_server::observation_size(c_); }
   [[nodiscard]] int max_episode_steps() const override { return c_.max_steps + 1; }
   [[nodiscard]] std::string_view status_name(int status) const override { return hfo::status_name(status); }
@@ -121,18 +121,19 @@ class HfoServerEnv final : public Env {
     if (client_ == nullptr || episode_over_) {
       misuse("step() before reset() or after a terminal status; call reset() first");
     }
-    if (action.params.size() < static_cast<size_t>(hfo::param::kCount)) {
-      misuse("step(): the parameter vector must hold the 6 HFO parameters");
+    const int last_id = c_.shoot_action ? hfo::kShoot : hfo::kKick;
+    if (action.params.size() < static_cast<size_t>(action_space().num_params())) {
+      misuse("step(): the parameter vector must hold the action space's HFO parameters (6; 8 with env.shoot_action)");
     }
-    if (action.id < hfo::kDash || action.id > hfo::kKick) {
-      misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK)");
+    if (action.id < hfo::kDash || action.id > last_id) {
+      misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK; 4 SHOOT with env.shoot_action)");
     }
     const ServerCommandArgs a = server_command_args(action, clamps_);
     switch (action.id) {
       case hfo::kDash: client_->act(::hfo::DASH, a.p1, a.p2); break;
       case hfo::kTurn: client_->act(::hfo::TURN, a.p1); break;
       case hfo::kTackle: client_->act(::hfo::TACKLE, a.p1); break;
-      default: client_->act(::hfo::KICK, a.p1, a.p2); break;
+      default: client_->act(::hfo::KICK, a.p1, a.p2); break;  // KICK, and SHOOT (a kick of its own)
     }
     int status = server_step();
     ++steps_;

@@ -55,6 +55,7 @@ struct HfoServerConfig {
   int opponents = 0;           // defense players on the server: 1 with bin/HFO --defense-npcs 1 (a goalie)
   int max_steps = 500;         // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
   int connect_timeout_s = 30;  // how long the first reset() waits for a server to answer (env.server_connect_timeout_s)
+  bool shoot_action = false;   // the action space with SHOOT, a second kick (env.shoot_action, envs/hfo/hfo_env.hpp)
 };
 
 // How long a server that came up while the first reset() waited is given to fill its NPC slots

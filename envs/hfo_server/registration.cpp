@@ -24,6 +24,7 @@ HfoServerConfig server_config(const EnvParams& p) {
   s.opponents = p.boolean("goalie") ? 1 : 0;
   s.max_steps = static_cast<int>(p.integer("max_steps"));
   s.connect_timeout_s = static_cast<int>(p.integer("server_connect_timeout_s"));
+  s.shoot_action = p.boolean("shoot_action");
   return s;
 }
 
@@ -36,8 +37,8 @@ void register_hfo_server_env(EnvRegistry& registry) {
   r.description =
       "the real HFO server through its C++ client (a build with -DHFO_ROOT; the server's own flags set up the game, "
       "docs/hfo-server.md)";
-  // Of the embedded simulator's keys, goalie says the server runs one (bin/HFO --defense-npcs 1)
-  // and max_steps is its --frames-per-trial.
+  // Of the embedded simulator's keys, goalie says the server runs one (bin/HFO --defense-npcs 1),
+  // max_steps is its --frames-per-trial and shoot_action adds SHOOT, sent as a KICK.
   r.keys = {hfo::goalie_key(), hfo::max_steps_key(), EnvKey::text("server_host", d.host),
             EnvKey::integer("server_port", d.port, 1, 65535),
             // The server of the greedy evaluations that `pamdp train` and `pamdp learner` run; 0 = none.
@@ -45,7 +46,7 @@ void register_hfo_server_env(EnvRegistry& registry) {
             EnvKey::choice("server_encoding", hfo_server::kEncodingNames[static_cast<int>(d.encoding)],
                            {hfo_server::kEncodingNames[0], hfo_server::kEncodingNames[1]}),
             EnvKey::text("server_team", d.team), EnvKey::text_or_empty("server_config_dir", d.config_dir),
-            EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600)};
+            EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600), hfo::shoot_action_key()};
   r.make = [](const EnvParams& p) { return hfo_server::make_hfo_server_env(hfo_server::server_config(p)); };
   r.observation_size = [](const EnvParams& p) { return hfo_server::observation_size(hfo_server::server_config(p)); };
   r.gives_embedded_hfo_features = [](const EnvParams& p) { return p.text("server_encoding") == "embedded"; };

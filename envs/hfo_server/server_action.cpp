@@ -38,6 +38,9 @@ ServerCommandArgs server_command_args(const ParamAction& action, ActionClampCoun
     case hfo::kKick:
       return {power_within(p(hfo::param::kKickPower), 0.0, hfo::kMaxKickPower, counts.kick_power),
               direction_within(p(hfo::param::kKickDir), counts.direction)};
+    case hfo::kShoot:  // env.shoot_action: a KICK with SHOOT's own parameters
+      return {power_within(p(hfo::param::kShootPower), 0.0, hfo::kMaxKickPower, counts.kick_power),
+              direction_within(p(hfo::param::kShootDir), counts.direction)};
     default: return {};
   }
 }

@@ -37,8 +37,9 @@ struct ServerCommandArgs {
 };
 
 // The command arguments for `action` (ids and parameter layout of hfo::hfo_action_space()),
-// within the ranges above; adds to `counts` for every parameter that was outside. The caller
-// checks the id and that params holds the 6 parameters. No allocation.
+// within the ranges above; adds to `counts` for every parameter that was outside. SHOOT
+// (env.shoot_action) gives a KICK's arguments from its own two parameters. The caller checks the
+// id and that params holds the 6 parameters (8 with SHOOT). No allocation.
 ServerCommandArgs server_command_args(const ParamAction& action, ActionClampCounts& counts);
 
 }  // namespace pamdp::hfo_server
