@@ -304,6 +304,33 @@ TEST(Cli, EvalAgreementLetsTheOffensePlayAndAsksTheCheckpoint) {
   EXPECT_GT(a.at("actions").at("DASH").at("same_action").get<double>(), 0.9) << j.dump();
 }
 
+// A checkpoint trained with env.shoot_action (a second kick, SHOOT) plays with it: the committed
+// striker shoots with SHOOT and scores against agent2d's goalie (.844 on 1,000 episodes of these
+// starts; 40 here, so a bound well below), and its trace names SHOOT's two parameters.
+TEST(Cli, EvalPlaysACheckpointWithTheShootAction) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v1-close-in-shoot-seed2.ckpt";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pamdp_shoot_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "trace.csv").string();
+  const RunResult r =
+      run_pamdp("eval --checkpoint " + model + " --goalie --start hfo --episodes 40 --json --trace " + file,
+                Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(last_line(r.output));
+  EXPECT_GE(j.at("goal_rate").get<double>(), 0.6) << j.dump();
+  std::ifstream in(file);
+  std::string header;
+  ASSERT_TRUE(std::getline(in, header)) << file;
+  EXPECT_NE(header.find(",kick_power,kick_dir,shoot_power,shoot_dir,reward,"), std::string::npos) << header;
+  int shots = 0;
+  for (std::string line; std::getline(in, line);) {
+    shots += split(line, ',').at(2) == "SHOOT" ? 1 : 0;
+  }
+  EXPECT_GE(shots, j.at("outcomes").at("GOAL").get<int>() / 2);
+  std::filesystem::remove_all(dir);
+}
+
 // --shot picks the scripted offense's aim for --policy scripted and for --agreement alike; with
 // a checkpoint it needs --agreement (the offense does not play otherwise).
 TEST(Cli, EvalShotAimsTheOffenseThatPlays) {
