@@ -121,11 +121,10 @@ class HfoServerEnv final : public Env {
     if (client_ == nullptr || episode_over_) {
       misuse("step() before reset() or after a terminal status; call reset() first");
     }
-    const int last_id = c_.shoot_action ? hfo::kShoot : hfo::kKick;
     if (action.params.size() < static_cast<size_t>(action_space().num_params())) {
       misuse("step(): the parameter vector must hold the action space's HFO parameters (6; 8 with env.shoot_action)");
     }
-    if (action.id < hfo::kDash || action.id > last_id) {
+    if (action.id < hfo::kDash || action.id >= action_space().num_actions()) {
       misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK; 4 SHOOT with env.shoot_action)");
     }
     const ServerCommandArgs a = server_command_args(action, clamps_);
