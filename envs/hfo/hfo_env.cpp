@@ -118,7 +118,7 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, const Pl
 
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
   if (action.params.size() < static_cast<size_t>(action_space().num_params())) {
-    misuse("step(): the parameter vector must hold the action space's HFO parameters (6; 8 with env.shoot_action)");
+    misuse("step(): the parameter vector must hold the 6 HFO parameters (8 with env.shoot_action)");
   }
   if (episode_over_) {
     misuse("step() after a terminal status; call reset() first");

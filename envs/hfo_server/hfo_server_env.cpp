@@ -122,7 +122,7 @@ class HfoServerEnv final : public Env {
       misuse("step() before reset() or after a terminal status; call reset() first");
     }
     if (action.params.size() < static_cast<size_t>(action_space().num_params())) {
-      misuse("step(): the parameter vector must hold the action space's HFO parameters (6; 8 with env.shoot_action)");
+      misuse("step(): the parameter vector must hold the 6 HFO parameters (8 with env.shoot_action)");
     }
     if (action.id < hfo::kDash || action.id >= action_space().num_actions()) {
       misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK; 4 SHOOT with env.shoot_action)");
