@@ -553,13 +553,12 @@ TEST(ActorLoop, JoinRetriesOnAFreshSocketWhenTheLearnerDoesNotAnswer) {
 
 TEST(LearnerLink, JoinGivesUpAfterItsTimeout) {
   net::Context ctx;
-  std::string nobody;
-  {
-    FakeShard closed(ctx);
-    nobody = closed.endpoint();
-  }
+  // A bound socket that never answers a join. It holds its port for the whole test: a port
+  // closed and left free could be taken by a learner of a test running beside this one, which
+  // would answer (a fresh clone's ctest -j2 once joined one that way).
+  FakeShard silent(ctx);
   LearnerLinkConfig c;
-  c.join_endpoint = nobody;
+  c.join_endpoint = silent.endpoint();
   c.name = "test";
   c.join_retry_ms = 100;
   c.join_timeout_ms = 300;
