@@ -173,10 +173,8 @@ TEST(Cli, EvalRandomPolicyPlaysAnyEnv) {
 // --trace writes one CSV row per step (plus a header naming every column) and leaves the
 // table and the JSON as they are without it.
 TEST(Cli, EvalTraceWritesOneRowPerStep) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("pamdp_trace_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string file = (dir / "trace.csv").string();
+  const TempFile trace(".trace.csv", "");
+  const std::string& file = trace.path();
   const RunResult traced = run_pamdp("eval --episodes 4 --seed 3 --json --trace " + file, Capture::kStdoutOnly);
   const RunResult plain = run_pamdp("eval --episodes 4 --seed 3 --json", Capture::kStdoutOnly);
   ASSERT_EQ(traced.exit_code, 0) << traced.output;
@@ -202,7 +200,6 @@ TEST(Cli, EvalTraceWritesOneRowPerStep) {
   }
   EXPECT_EQ(rows, static_cast<int>(std::lround(j.at("avg_steps").get<double>() * 4)));
   EXPECT_EQ(goals, j.at("outcomes").at("GOAL").get<int>());
-  std::filesystem::remove_all(dir);
 }
 
 // A simulator flag given with --checkpoint changes that setting of the checkpoint's env: --start hfo
@@ -252,8 +249,8 @@ TEST(Cli, EvalPlaysTheActorAverageByDefaultWhenTheRunKeptOne) {
   const auto target = ddpg.target_actor().params();
   std::copy(target.begin(), target.end(), ddpg.actor_average().params().begin());
   meta.config_toml = pamdp::app::to_toml(c);
-  const std::string averaged =
-      (std::filesystem::temp_directory_path() / ("pamdp_cli_average_" + std::to_string(::getpid()) + ".ckpt")).string();
+  const TempFile averaged_file(".average.ckpt", "");
+  const std::string& averaged = averaged_file.path();
   pamdp::save_checkpoint(averaged, learner, meta);
 
   const std::string eval = "eval --episodes 20 --json --checkpoint ";
@@ -269,7 +266,6 @@ TEST(Cli, EvalPlaysTheActorAverageByDefaultWhenTheRunKeptOne) {
   EXPECT_EQ(last_line(plain.output), last_line(average.output));
   EXPECT_EQ(last_line(average.output), last_line(as_target.output));
   EXPECT_NE(last_line(average.output), last_line(online.output));
-  std::filesystem::remove(averaged);
 
   const RunResult refused = run_pamdp(eval + model + " --actor average");
   EXPECT_NE(refused.exit_code, 0);
@@ -309,10 +305,8 @@ TEST(Cli, EvalAgreementLetsTheOffensePlayAndAsksTheCheckpoint) {
 // starts; 40 here, so a bound well below), and its trace names SHOOT's two parameters.
 TEST(Cli, EvalPlaysACheckpointWithTheShootAction) {
   const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-1v1-close-in-shoot-seed2.ckpt";
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("pamdp_shoot_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string file = (dir / "trace.csv").string();
+  const TempFile trace(".trace.csv", "");
+  const std::string& file = trace.path();
   const RunResult r =
       run_pamdp("eval --checkpoint " + model + " --goalie --start hfo --episodes 40 --json --trace " + file,
                 Capture::kStdoutOnly);
@@ -328,7 +322,6 @@ TEST(Cli, EvalPlaysACheckpointWithTheShootAction) {
     shots += split(line, ',').at(2) == "SHOOT" ? 1 : 0;
   }
   EXPECT_GE(shots, j.at("outcomes").at("GOAL").get<int>() / 2);
-  std::filesystem::remove_all(dir);
 }
 
 // --shot picks the scripted offense's aim for --policy scripted and for --agreement alike; with
