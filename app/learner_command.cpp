@@ -123,11 +123,20 @@ void run_learner(const LearnerCliOptions& o) {
   server.on_metrics_urls = [&](const std::vector<std::string>& urls) {
     write_metrics_urls((fs::path(run_dir) / "metrics_urls.txt").string(), urls);
   };
+  // train.max_episodes ends the run here as it ends `pamdp train`'s: after the episode report that
+  // reaches it (a resumed run counts the episodes before it), with the same final checkpoint.
+  const auto episodes_done = [&] { return c.train.max_episodes > 0 && run.episodes() >= c.train.max_episodes; };
   server.on_episode = [&](const EpisodeSummary& e) {
     learner_metrics.on_episode(e);
     run.record_env_steps(e.steps);
     run.record_episode({e.status, e.ret, e.steps, e.actor_id, e.policy_version, e.scripted});
+    if (episodes_done()) {
+      server.stop();
+    }
   };
+  if (episodes_done()) {
+    server.stop();
+  }
   server.on_tick = [&](const LearnerCounters& k) {
     learner_metrics.on_tick(k, algorithm->updates(), server.metrics_urls().size());
     if (run.checkpoint_due()) {
