@@ -50,7 +50,7 @@ StepResult EpisodePlayer::step(const Act& act, EpsilonGreedy& explore, double ep
     act(obs_, net_out_);
   }
   const int id = demo_ ? write_teacher_output(space_, teacher_->act(obs_), net_out_, stored_)
-                       : explore.select(net_out_, epsilon, stored_);
+                       : explore.select(obs_, net_out_, epsilon, stored_);
   if (label_) {  // before the step: the label is for the state the agent acted in
     write_teacher_output(space_, teacher_->act(obs_), net_out_, label_out_);
   }

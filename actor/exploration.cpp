@@ -53,6 +53,21 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
   if (std::all_of(masked_.begin(), masked_.end(), [](bool m) { return m; })) {
     throw std::invalid_argument("exploration: every action is masked");
   }
+  for (const ActionGate& g : config.gates) {
+    if (g.action < 0 || g.action >= num_actions_ || g.feature < 0) {
+      throw std::invalid_argument("exploration: a gated action or its feature is out of range");
+    }
+  }
+  gates_ = config.gates;
+  // Every state must leave one action open: an ungated, unmasked one.
+  bool open = false;
+  for (int a = 0; a < num_actions_; ++a) {
+    open = open || (!masked_[static_cast<size_t>(a)] &&
+                    std::none_of(gates_.begin(), gates_.end(), [a](const ActionGate& g) { return g.action == a; }));
+  }
+  if (!open) {
+    throw std::invalid_argument("exploration: every unmasked action is gated; leave one ungated");
+  }
   for (const ParamSpec& p : space.params) {
     lo_.push_back(p.lo);
     hi_.push_back(p.hi);
@@ -79,11 +94,20 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
 }
 
 int EpsilonGreedy::greedy(std::span<const float> output) const {
+  if (!gates_.empty()) {
+    throw std::logic_error("EpsilonGreedy::greedy: with gated actions, pass the observation");
+  }
+  return greedy({}, output);
+}
+
+int EpsilonGreedy::greedy(std::span<const float> obs, std::span<const float> output) const {
   int best = -1;
   float best_score = -std::numeric_limits<float>::infinity();
   for (int a = 0; a < num_actions_; ++a) {
     const float s = output[static_cast<size_t>(a)];
-    if (!masked_[static_cast<size_t>(a)] && (best < 0 || s > best_score)) {
+    const bool shut = std::any_of(gates_.begin(), gates_.end(),
+                                  [a, obs](const ActionGate& g) { return g.action == a && g.shut(obs); });
+    if (!masked_[static_cast<size_t>(a)] && !shut && (best < 0 || s > best_score)) {
       best = a;
       best_score = s;
     }
@@ -92,6 +116,14 @@ int EpsilonGreedy::greedy(std::span<const float> output) const {
 }
 
 int EpsilonGreedy::select(std::span<const float> net_output, double epsilon, std::span<float> stored) {
+  if (!gates_.empty()) {
+    throw std::logic_error("EpsilonGreedy::select: with gated actions, pass the observation");
+  }
+  return select({}, net_output, epsilon, stored);
+}
+
+int EpsilonGreedy::select(std::span<const float> obs, std::span<const float> net_output, double epsilon,
+                          std::span<float> stored) {
   if (epsilon > 0.0 && rng_.uniform() < epsilon) {
     for (int a = 0; a < num_actions_; ++a) {
       stored[static_cast<size_t>(a)] = static_cast<float>(rng_.uniform(-1.0, 1.0));
@@ -110,7 +142,7 @@ int EpsilonGreedy::select(std::span<const float> net_output, double epsilon, std
       v = std::clamp(v + static_cast<float>(rng_.normal()) * noise_std_[i], bound_lo_[i], bound_hi_[i]);
     }
   }
-  return greedy(stored);
+  return greedy(obs, stored);
 }
 
 }  // namespace pamdp

@@ -28,6 +28,8 @@ struct ExplorationConfig {
   double epsilon_end = 0.1;
   int64_t epsilon_anneal_updates = 10000;  // paper: 10,000 updates
   std::vector<int> masked_actions;         // never executed (HFO: Tackle)
+  // Taken only where their feature is on (exploration.gated_actions, resolved against the env).
+  std::vector<ActionGate> gates;
   // Sampling range of each parameter for random actions; empty = the action space's bounds.
   std::vector<float> random_param_lo;
   std::vector<float> random_param_hi;
@@ -71,13 +73,17 @@ class EpsilonGreedy {
   // Picks the action for this step. `net_output` is the actor's output vector (scores then
   // params); `stored` receives the vector to store in replay (net_output or the random draw).
   // Returns the chosen discrete action id; its parameters are `stored` minus the scores.
+  // With gates (ExplorationConfig::gates), the obs overload must be used: a gated action is
+  // neither a random nor a greedy choice where its gate is shut in `obs`.
   int select(std::span<const float> net_output, double epsilon, std::span<float> stored);
+  int select(std::span<const float> obs, std::span<const float> net_output, double epsilon, std::span<float> stored);
   // Whether select() at this ε may read net_output: below ε = 1, or when its random steps keep
   // the network's parameters (exploration.uniform_random_params off).
   [[nodiscard]] bool uses_output(double epsilon) const { return epsilon < 1.0 || !uniform_random_params_; }
 
-  // Arg-max of the scores over unmasked actions.
+  // Arg-max of the scores over unmasked actions (and, given obs, over those whose gate is open).
   [[nodiscard]] int greedy(std::span<const float> output) const;
+  [[nodiscard]] int greedy(std::span<const float> obs, std::span<const float> output) const;
   // Offset of the parameters inside an output vector.
   [[nodiscard]] int num_actions() const { return num_actions_; }
 
@@ -86,6 +92,7 @@ class EpsilonGreedy {
  private:
   int num_actions_;
   std::vector<bool> masked_;
+  std::vector<ActionGate> gates_;
   std::vector<float> lo_;
   std::vector<float> hi_;
   std::vector<float> bound_lo_;  // the action space's bounds (parameter noise is clamped to them)

@@ -1,6 +1,7 @@
 // Builds the env an experiment config names, through the env registry (envs/registry.hpp).
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -82,6 +83,21 @@ inline ExplorationConfig resolve_exploration(const ExperimentConfig& c, const Ac
                                "' (valid: " + valid + ")");
     }
     e.masked_actions.push_back(id);
+  }
+  e.gates.clear();
+  const auto& gates = env_registry().find(c.env.name).action_gates;
+  for (const auto& name : c.gated_actions) {
+    const auto g = std::find_if(gates.begin(), gates.end(), [&name](const auto& ag) { return ag.first == name; });
+    if (g == gates.end()) {
+      std::string valid;
+      for (const auto& ag : gates) {
+        valid += (valid.empty() ? "" : ", ") + ag.first;
+      }
+      throw std::runtime_error("exploration.gated_actions: env '" + c.env.name + "' has no feature that gates '" +
+                               name + "' (it gates: " + (valid.empty() ? "none" : valid) +
+                               "); remove it from the list");
+    }
+    e.gates.push_back({space.find_action(name), g->second});
   }
   e.random_param_lo.clear();
   e.random_param_hi.clear();

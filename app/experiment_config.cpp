@@ -96,6 +96,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("exploration.epsilon_end", c.exploration.epsilon_end, 0.0, 1.0);
   v.integer("exploration.epsilon_anneal_updates", c.exploration.epsilon_anneal_updates, 0, INT64_MAX);
   v.str_list("exploration.masked_actions", c.masked_actions);
+  v.str_list("exploration.gated_actions", c.gated_actions);
   v.ranges("exploration.random_param_ranges", c.random_param_ranges);
   v.real("exploration.param_noise", c.exploration.param_noise, 0.0, 1.0);
   v.boolean("exploration.uniform_random_params", c.exploration.uniform_random_params);
@@ -589,7 +590,9 @@ std::unique_ptr<Algorithm> make_learner(const ExperimentConfig& config, int obs_
   args.ddpg = &config.ddpg;
   args.seed = seed;
   args.device = device.value_or(config.ddpg.device);
-  args.masked_actions = resolve_exploration(config, space).masked_actions;
+  const ExplorationConfig exploration = resolve_exploration(config, space);
+  args.masked_actions = exploration.masked_actions;
+  args.gates = exploration.gates;
   args.params = &config.algorithm_params;
   std::optional<ParameterPrior> prior;
   if (const auto& of = env_registry().find(config.env.name).parameter_prior) {

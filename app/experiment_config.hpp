@@ -84,6 +84,9 @@ struct ExperimentConfig {
   AlgorithmParams algorithm_params = algorithm_registry().defaults();
   ExplorationConfig exploration;
   std::vector<std::string> masked_actions = {"TACKLE"};
+  // Actions taken only where the env's feature says they can act (exploration.gated_actions;
+  // HFO: KICK only with the kickable bit on), by name; the env declares which it can gate.
+  std::vector<std::string> gated_actions;
   // Random-action sampling ranges overriding the action-space bounds, by parameter name
   // (the paper's code explores dash power in [-100, 100]).
   std::vector<std::pair<std::string, std::pair<float, float>>> random_param_ranges = {

@@ -47,6 +47,16 @@ struct ParameterPrior {
   std::vector<float> bias;     // num_params
 };
 
+// An action that acts only where one observation feature is on (> 0), and is a no-op elsewhere:
+// HFO's KICK without the kickable bit (feature 12), which the client never sends (librcsc's
+// doKick; ../shared/hfo-reference.md §2.7). A learner told of a gate neither takes the action nor
+// counts its value where the gate is shut (exploration.gated_actions).
+struct ActionGate {
+  int action = -1;
+  int feature = -1;
+  [[nodiscard]] bool shut(std::span<const float> obs) const { return !(obs[static_cast<size_t>(feature)] > 0.0F); }
+};
+
 // One chosen action: the discrete id and a view of the whole parameter vector (only the
 // entries the action owns are read). Non-owning; valid for the duration of a step() call.
 struct ParamAction {

@@ -21,6 +21,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -98,6 +99,10 @@ struct EnvRegistration {
   // Its action space is HFO's (DASH, TURN, KICK, TACKLE), which `pamdp eval`'s scripted and
   // random policies play.
   bool hfo_actions = false;
+  // The actions that can act only where one of its features is on (> 0), by action name and
+  // feature index: elsewhere they are no-ops. exploration.gated_actions names those a learner
+  // should neither take nor value there (core/action_space.hpp, ActionGate).
+  std::vector<std::pair<std::string, int>> action_gates;
   // A bound on every |observation value|.
   float observation_bound = 1.0F;
   // How many of it one process may play at once (`pamdp actor --envs`); 0 = any number.

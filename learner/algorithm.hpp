@@ -190,6 +190,10 @@ struct AlgorithmArgs {
   // Actions never taken (exploration.masked_actions, resolved): a value-based learner leaves them
   // out of its max.
   std::vector<int> masked_actions;
+  // Actions that act only where a feature is on (exploration.gated_actions, resolved): a
+  // value-based learner leaves them out of its max, its taken action and its parameter loss in
+  // the states where they are shut.
+  std::vector<ActionGate> gates;
   // The registered algorithms' own keys; null: their defaults.
   const AlgorithmParams* params = nullptr;
   // The env's hand-made parameter policy, when it has one (envs/registry.hpp): what a learner

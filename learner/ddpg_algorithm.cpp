@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <sstream>
+#include <stdexcept>
 
 namespace pamdp {
 namespace {
@@ -87,6 +88,12 @@ void DdpgAlgorithm::warm_started() {
 void register_ddpg_algorithm(AlgorithmRegistry& registry) {
   registry.add({"ddpg", "DDPG with inverting, zeroing or squashing gradient bounds (Hausknecht & Stone 2016)",
                 [](const AlgorithmArgs& a) {
+                  if (!a.gates.empty()) {
+                    throw std::invalid_argument(
+                        "exploration.gated_actions: DDPG's critic reads the action scores its actor stored, "
+                        "and a gate would take an action they do not rank first; gate actions with "
+                        "train.algorithm = \"pdqn\" or \"mpdqn\", or leave exploration.gated_actions empty");
+                  }
                   return std::make_unique<DdpgAlgorithm>(a.obs_dim, *a.space, *a.ddpg, a.seed, a.device);
                 }});
 }

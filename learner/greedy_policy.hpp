@@ -23,7 +23,7 @@ class GreedyActorPolicy final : public Policy {
 
   ParamAction act(std::span<const float> obs) override {
     algorithm_.act(obs, output_, copy_);
-    const int id = select_.greedy(output_);
+    const int id = select_.greedy(obs, output_);
     return {id, std::span<const float>(output_).subspan(static_cast<size_t>(num_actions_))};
   }
 

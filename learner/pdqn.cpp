@@ -154,6 +154,28 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   }
 }
 
+void Pdqn::set_gates(std::vector<ActionGate> gates) {
+  for (const ActionGate& g : gates) {
+    if (g.action < 0 || g.action >= num_actions_ || g.feature < 0 || g.feature >= obs_dim_) {
+      throw std::invalid_argument("P-DQN: a gated action or its feature is out of range");
+    }
+    if (masked_[static_cast<size_t>(g.action)]) {
+      throw std::invalid_argument("P-DQN: action " + std::to_string(g.action) +
+                                  " is both masked and gated; list it in one of exploration.masked_actions and "
+                                  "exploration.gated_actions");
+    }
+  }
+  bool open = false;
+  for (int k = 0; k < num_actions_; ++k) {
+    open = open || (!masked_[static_cast<size_t>(k)] &&
+                    std::none_of(gates.begin(), gates.end(), [k](const ActionGate& g) { return g.action == k; }));
+  }
+  if (!open) {
+    throw std::invalid_argument("P-DQN: every unmasked action is gated; leave one ungated");
+  }
+  gates_ = std::move(gates);
+}
+
 void Pdqn::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
   const bool target = copy == ActorCopy::kTarget;
   forward_(target ? target_param_ : param_, target ? target_q_ : q_,
@@ -237,7 +259,7 @@ void Pdqn::targets(const BatchView& batch, int B) {
   for (int j = 0; j < B; ++j) {
     float best = -std::numeric_limits<float>::infinity();
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)]) {
+      if (!masked_[static_cast<size_t>(k)] && open(k, batch.next_states, j)) {
         best = std::max(best, q_of(q_next, k, j, B));
       }
     }
@@ -250,11 +272,13 @@ void Pdqn::targets(const BatchView& batch, int B) {
     }
     y_(j) = y;
   }
-  // The action each sample took: the arg-max of its stored scores over the unmasked actions.
+  // The action each sample took: the arg-max of its stored scores over the unmasked actions open
+  // in its state (as the actor chose it: actor/exploration.cpp).
   for (int j = 0; j < B; ++j) {
     int k_best = -1;
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)] && (k_best < 0 || batch.actions(k, j) > batch.actions(k_best, j))) {
+      if (!masked_[static_cast<size_t>(k)] && open(k, batch.states, j) &&
+          (k_best < 0 || batch.actions(k, j) > batch.actions(k_best, j))) {
         k_best = k;
       }
     }
@@ -299,7 +323,7 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
   const float per_sample = -1.0F / static_cast<float>(B);
   for (int j = 0; j < B; ++j) {
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)]) {
+      if (!masked_[static_cast<size_t>(k)] && open(k, batch.states, j)) {
         loss -= q_of(q, k, j, B);
         d_q_(k, multipass_ ? pass_[static_cast<size_t>(k)] * B + j : j) = per_sample;
       }
@@ -349,7 +373,7 @@ Pdqn::Losses Pdqn::losses(const BatchView& batch) {
   const auto qx = q_.forward(q_in_.leftCols(cols));
   for (int j = 0; j < B; ++j) {
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)]) {
+      if (!masked_[static_cast<size_t>(k)] && open(k, batch.states, j)) {
         l.param_loss -= static_cast<double>(q_of(qx, k, j, B)) / B;
       }
     }
@@ -425,8 +449,10 @@ void register_pdqn_algorithms(AlgorithmRegistry& registry) {
                   [multipass](const AlgorithmArgs& a) {
                     const PdqnSettings settings =
                         PdqnSettings::from(a.params != nullptr ? *a.params : algorithm_registry().defaults());
-                    return std::make_unique<Pdqn>(a.obs_dim, *a.space, *a.ddpg, a.seed, multipass, a.masked_actions,
-                                                  settings, a.prior);
+                    auto pdqn = std::make_unique<Pdqn>(a.obs_dim, *a.space, *a.ddpg, a.seed, multipass,
+                                                       a.masked_actions, settings, a.prior);
+                    pdqn->set_gates(a.gates);
+                    return pdqn;
                   },
                   pdqn_keys()});
   }

@@ -71,6 +71,12 @@ class Pdqn final : public Algorithm {
   Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, bool multipass,
        std::vector<int> masked_actions = {}, const PdqnSettings& settings = {}, const ParameterPrior* prior = nullptr);
 
+  // Actions that act only where their feature is on (core/action_space.hpp): where shut in a
+  // state, left out of the max over its successor's actions, of the arg-max that recovers the
+  // action a stored sample took, and of the parameter loss. std::invalid_argument for an action
+  // or feature out of range, a masked action, or every unmasked action gated.
+  void set_gates(std::vector<ActionGate> gates);
+
   [[nodiscard]] std::string_view name() const override { return multipass_ ? "mpdqn" : "pdqn"; }
   [[nodiscard]] int obs_dim() const override { return obs_dim_; }
   [[nodiscard]] int output_width() const override { return num_actions_ + num_params_; }
@@ -121,6 +127,15 @@ class Pdqn final : public Algorithm {
   void fill_taken_input(const Eigen::Ref<const Eigen::MatrixXf>& states, const Eigen::Ref<const Eigen::MatrixXf>& x,
                         int B);
   // Q(s, k, ·) of sample j from a forward over fill_q_input's columns.
+  // Whether action k is open in column j of `states` (no gate of k is shut there).
+  [[nodiscard]] bool open(int k, const Eigen::Ref<const Eigen::MatrixXf>& states, int j) const {
+    for (const ActionGate& g : gates_) {
+      if (g.action == k && !(states(g.feature, j) > 0.0F)) {
+        return false;
+      }
+    }
+    return true;
+  }
   [[nodiscard]] float q_of(const Mlp<float>::ConstBlock& q, int k, int j, int B) const {
     return multipass_ ? q(k, pass_[static_cast<size_t>(k)] * B + j) : q(k, j);
   }
@@ -137,6 +152,7 @@ class Pdqn final : public Algorithm {
   PdqnSettings settings_;
   OutputBounds param_bounds_;
   std::vector<bool> masked_;
+  std::vector<ActionGate> gates_;
   std::vector<int> owner_;  // per parameter: the action that owns it
   std::vector<std::vector<int>> owned_;
   std::vector<int> pass_;  // per action: its pass in a multi-pass batch, -1 when masked

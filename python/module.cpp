@@ -518,10 +518,10 @@ class PyPolicy {
       int id = 0;
       const float* chosen = output_.data() + na;
       if (explore_) {
-        id = select_->select(output_, epsilon_, stored_);
+        id = select_->select(row, output_, epsilon_, stored_);
         chosen = stored_.data() + na;
       } else {
-        id = select_->greedy(output_);
+        id = select_->greedy(row, output_);
       }
       ids.mutable_data()[b] = id;
       for (size_t a = 0; a < na; ++a) {

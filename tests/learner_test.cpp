@@ -230,6 +230,42 @@ TEST(Exploration, RandomActionsCanKeepThePolicysParameters) {
   }
 }
 
+// exploration.gated_actions: a gated action (HFO's KICK, on the kickable feature) is neither the
+// greedy nor a random choice where its feature is off, and is both where it is on; without the
+// observation a gated selector refuses to choose.
+TEST(Exploration, AGatedActionIsTakenOnlyWhereItsFeatureIsOn) {
+  const ActionSpace& space = hfo::hfo_action_space();
+  ExplorationConfig cfg;
+  cfg.masked_actions = {hfo::kTackle};
+  cfg.gates = {{hfo::kKick, 12}};
+  EpsilonGreedy eg(space, cfg, 3);
+  std::vector<float> net(10, 0.0F);
+  net[hfo::kKick] = 2.0F;  // the network prefers kick, then turn
+  net[hfo::kTurn] = 1.0F;
+  std::vector<float> shut(58, 0.0F);
+  shut[12] = -1.0F;
+  std::vector<float> open = shut;
+  open[12] = 1.0F;
+  std::vector<float> stored(10);
+  EXPECT_EQ(eg.greedy(shut, net), hfo::kTurn);
+  EXPECT_EQ(eg.greedy(open, net), hfo::kKick);
+  EXPECT_EQ(eg.select(shut, net, 0.0, stored), hfo::kTurn);
+  EXPECT_EQ(stored, net);  // the stored scores are the network's: the learner applies the gate itself
+  std::vector<int> counts_shut(4, 0);
+  std::vector<int> counts_open(4, 0);
+  for (int i = 0; i < 3000; ++i) {
+    ++counts_shut[static_cast<size_t>(eg.select(shut, net, 1.0, stored))];
+    ++counts_open[static_cast<size_t>(eg.select(open, net, 1.0, stored))];
+  }
+  EXPECT_EQ(counts_shut[hfo::kKick], 0);
+  EXPECT_NEAR(counts_shut[hfo::kDash] / 3000.0, 0.5, 0.045);
+  EXPECT_NEAR(counts_open[hfo::kKick] / 3000.0, 1.0 / 3.0, 0.045);
+  EXPECT_THROW((void)eg.greedy(net), std::logic_error);
+  EXPECT_THROW(eg.select(net, 0.0, stored), std::logic_error);
+  cfg.gates = {{hfo::kDash, 12}, {hfo::kTurn, 12}, {hfo::kKick, 12}};  // no action left in some states
+  EXPECT_THROW(EpsilonGreedy(space, cfg, 3), std::invalid_argument);
+}
+
 TEST(ReplayBuffer, FifoAndSampling) {
   ReplayBuffer rb(3, 1, 1);
   Rng rng(1);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "actor/acting_policy.hpp"
+#include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
 #include "app/trainer.hpp"
 #include "envs/toy/reach_stop.hpp"
@@ -172,6 +173,86 @@ TEST(Pdqn, LossesByHand) {
   }
 }
 
+// A gated action (exploration.gated_actions; here "one", open where state feature 0 > 0): where
+// its gate is shut it is not the action a sample took though its stored score is highest, not in
+// the target's max over the next state's actions, and not in the parameter loss; where open it is
+// all three. Both losses by hand, and their gradients against finite differences.
+TEST(Pdqn, GatesByHand) {
+  for (const bool multipass : {false, true}) {
+    ActionSpace space = test_space();
+    for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
+      p.lo = -10.0F;
+      p.hi = 10.0F;
+    }
+    Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, multipass);
+    pdqn.set_gates({{0, 0}});
+    Rng rng(11);
+    pdqn.target_q_net().init_gaussian(rng, 0.5F);
+    pdqn.target_param_net().init_gaussian(rng, 0.5F);
+    Batch b;
+    b.actions.col(0) << 0.9F, 0.2F, 0.1F, 0.5F, -0.5F, 0.25F;  // "one" ranks first: shut at 0, open at 1
+    b.actions.col(1) << 0.9F, 0.2F, 0.1F, 0.5F, -0.5F, 0.25F;
+    b.states(0, 0) = -0.5F;
+    b.states(0, 1) = 0.5F;
+    b.next_states(0, 2) = -0.5F;
+    b.next_states(0, 3) = 0.5F;
+    const BatchView v = b.view();
+    double q_loss = 0.0;
+    double param_loss = 0.0;
+    std::vector<float> out(6);
+    std::vector<float> next(6);
+    int shut_seen = 0;
+    for (int j = 0; j < kB; ++j) {
+      const bool open = b.states(0, j) > 0.0F;
+      const bool next_open = b.next_states(0, j) > 0.0F;
+      shut_seen += open ? 0 : 1;
+      int taken = -1;
+      for (const int k : {0, 1, 2}) {
+        if (k == 0 && !open) {
+          continue;
+        }
+        taken = taken < 0 || b.actions(k, j) > b.actions(taken, j) ? k : taken;
+      }
+      if (j < 2) {
+        ASSERT_EQ(taken == 0, j == 1);
+      }
+      Eigen::MatrixXf in(kObs + 3, 1);
+      in.col(0).head(kObs) = b.states.col(j);
+      in.col(0).tail(3) = b.actions.col(j).tail(3);
+      if (multipass) {
+        for (int p = 0; p < 3; ++p) {
+          const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
+          if (std::find(owned.begin(), owned.end(), p) == owned.end()) {
+            in(kObs + p, 0) = 0.0F;
+          }
+        }
+      }
+      const float q = pdqn.q_net().forward(in)(taken, 0);
+      pdqn.act({b.next_states.col(j).data(), kObs}, next, ActorCopy::kTarget);
+      const float best = next_open ? std::max({next[0], next[1], next[2]}) : std::max(next[1], next[2]);
+      const float y = b.rewards(j) + (b.terminal(j) > 0.5F ? 0.0F : 0.9F * best);
+      q_loss += 0.5 * (q - y) * (q - y) / kB;
+      pdqn.act({b.states.col(j).data(), kObs}, out, ActorCopy::kOnline);
+      param_loss -= ((open ? out[0] : 0.0F) + out[1] + out[2]) / kB;
+    }
+    ASSERT_GT(shut_seen, 0);
+    const Pdqn::Losses l = pdqn.losses(v);
+    EXPECT_NEAR(l.q_loss, q_loss, 1e-5 * (1.0 + q_loss)) << (multipass ? "mpdqn" : "pdqn");
+    EXPECT_NEAR(l.param_loss, param_loss, 1e-5 * (1.0 + std::abs(param_loss))) << (multipass ? "mpdqn" : "pdqn");
+    pdqn.gradients(v);
+    expect_gradients(
+        pdqn.q_net(), [&] { return pdqn.losses(v).q_loss; }, "Q loss");
+    pdqn.gradients(v);
+    expect_gradients(
+        pdqn.param_net(), [&] { return pdqn.losses(v).param_loss; }, "parameter loss");
+  }
+  const ActionSpace space = test_space();
+  Pdqn bad(kObs, space, small(BoundMethod::kZeroing), 5, true, /*masked_actions=*/{1});
+  EXPECT_THROW(bad.set_gates({{1, 0}}), std::invalid_argument);          // masked and gated
+  EXPECT_THROW(bad.set_gates({{0, kObs}}), std::invalid_argument);       // no such feature
+  EXPECT_THROW(bad.set_gates({{0, 0}, {2, 1}}), std::invalid_argument);  // nothing left ungated
+}
+
 // MP-DQN's score k comes from a pass that sees only action k's parameters, all K passes of
 // x(s): rebuilt by hand here from act()'s own parameters.
 TEST(Pdqn, MultiPassScoresComeFromOnePassPerAction) {
@@ -293,6 +374,33 @@ TEST(Pdqn, RefusesSettingsItDoesNotHave) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
+}
+
+// exploration.gated_actions resolves against the env's own gates: KICK on HFO (its kickable
+// feature) reaches P-DQN/MP-DQN; an env without that gate, or DDPG (whose critic reads the stored
+// scores a gate overrides), is refused with the key named.
+TEST(Pdqn, GatedActionsComeFromTheEnvAndOnlyValueLearnersTakeThem) {
+  const auto learner = [](const std::string& toml) {
+    const app::ExperimentConfig c = app::parse_experiment_config(toml, "test", {});
+    const auto env = app::make_env(c.env);
+    return app::make_learner(c, env->observation_size(), env->action_space(), 1, UpdateDevice::kCpu);
+  };
+  const std::string gated = "[exploration]\ngated_actions = [\"KICK\"]\n";
+  EXPECT_NO_THROW(learner("[env]\nname = \"hfo\"\n[train]\nalgorithm = \"mpdqn\"\n" + gated));
+  const auto refused = [&](const std::string& toml, const char* says) {
+    try {
+      learner(toml);
+      ADD_FAILURE() << toml << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("exploration.gated_actions"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  refused("[env]\nname = \"hfo\"\n[train]\nalgorithm = \"ddpg\"\n" + gated, "DDPG");
+  refused(
+      "[env]\nname = \"platform\"\n[train]\nalgorithm = \"mpdqn\"\n"
+      "[exploration]\nmasked_actions = []\ngated_actions = [\"JUMP\"]\n",
+      "platform");
 }
 
 // A random hand-made parameter policy for test_space() (3 parameters over kObs features).

@@ -1,6 +1,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "envs/hfo/features.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/settings.hpp"
 #include "envs/registry.hpp"
@@ -121,6 +122,7 @@ void register_hfo_env(EnvRegistry& registry) {
   r.observation_size = [](const EnvParams& p) { return hfo::HfoEnv(hfo::sim_config(p)).observation_size(); };
   r.gives_embedded_hfo_features = [](const EnvParams&) { return true; };
   r.hfo_actions = true;
+  r.action_gates = {{"KICK", hfo::feat::kKickable}};  // the client sends no kick without it
   registry.add(std::move(r));
 }
 

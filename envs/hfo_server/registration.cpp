@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "envs/hfo/features.hpp"
 #include "envs/hfo/settings.hpp"
 #include "envs/hfo_server/hfo_server_env.hpp"
 #include "envs/registry.hpp"
@@ -73,6 +74,7 @@ void register_hfo_server_env(EnvRegistry& registry) {
     return " at " + p.text("server_host") + ":" + std::to_string(p.integer("server_port"));
   };
   r.hfo_actions = true;
+  r.action_gates = {{"KICK", hfo::feat::kKickable}};  // the real server's feature 12, as the embedded one
   r.max_per_process = 1;
   r.max_per_process_note =
       "plays one HFO server per actor; start one actor per server, each with --envs 1 --server-port PORT";
