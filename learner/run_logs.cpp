@@ -268,7 +268,8 @@ void for_each_logged_episode(const fs::path& dir, const std::function<void(const
   }
 }
 
-BestEval::BestEval(fs::path file, std::string role) : file_(std::move(file)), role_(std::move(role)) {
+BestEval::BestEval(fs::path file, std::string role, double steps_limit)
+    : file_(std::move(file)), role_(std::move(role)), steps_limit_(steps_limit) {
   std::ifstream in(file_);
   EvalResult r;
   if (in >> r.goal_rate >> r.avg_steps_to_goal >> r.avg_return) {
@@ -281,6 +282,14 @@ bool BestEval::beats_best(const EvalResult& r) const {
     return true;
   }
   const EvalResult& b = *best_;
+  if (steps_limit_ > 0.0) {
+    const auto within = [this](const EvalResult& e) {
+      return e.goal_rate > 0.0 && e.avg_steps_to_goal <= steps_limit_;
+    };
+    if (within(r) != within(b)) {
+      return within(r);
+    }
+  }
   if (r.goal_rate != b.goal_rate) {
     return r.goal_rate > b.goal_rate;
   }

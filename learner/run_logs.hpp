@@ -121,8 +121,12 @@ struct LoggedEpisode {
 void for_each_logged_episode(const std::filesystem::path& dir, const std::function<void(const LoggedEpisode&)>& visit);
 
 // Keeps the best greedy evaluation of a run: a higher success rate wins, then fewer steps to
-// success, then a higher return. Persisted in a small text file (the run directory's
-// best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.
+// success, then a higher return. With a steps limit (train.best_steps_limit > 0), an evaluation
+// with successes whose average steps to success are within the limit beats one over it, whatever
+// their rates; two on the same side compare as above. For a goal that counts both (HFO: scoring
+// at least .99 in at most 75 steps), an early pick that scores high but slowly does not hold
+// best.ckpt against later, faster candidates that score a little less. Persisted in a small text file (the run
+// directory's best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.
 //
 // The maximum over a run's ~200 evaluations of 100 episodes is biased upwards: the policy that
 // scored 1.0 on one set of starts scores .93 on another. With `confirm`, an evaluation that
@@ -132,7 +136,7 @@ void for_each_logged_episode(const std::filesystem::path& dir, const std::functi
 class BestEval {
  public:
   // `role` ("train", "learner") begins the log line of each confirmation.
-  explicit BestEval(std::filesystem::path file, std::string role = "train");
+  explicit BestEval(std::filesystem::path file, std::string role = "train", double steps_limit = 0.0);
 
   // True when the (confirmed) result beats every one kept before (the first one always does);
   // then the file is rewritten (atomically) with it and `updates`. `kept`, when given, receives
@@ -147,6 +151,7 @@ class BestEval {
 
   std::filesystem::path file_;
   std::string role_;
+  double steps_limit_;
   std::optional<EvalResult> best_;
 };
 

@@ -113,7 +113,7 @@ CheckpointMeta TrainingRun::start(bool resume) {
                 episodes_ + 1);
     }
   }
-  best_.emplace(spec_.dir / "best_eval.txt", spec_.role);
+  best_.emplace(spec_.dir / "best_eval.txt", spec_.role, spec_.loop.best_steps_limit);
   start_ = std::chrono::steady_clock::now();
   last_checkpoint_ = last_row_ = base_seconds_;
   row_updates_ = algorithm_.updates();

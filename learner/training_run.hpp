@@ -51,6 +51,9 @@ struct TrainLoopConfig {
   // > 0: an evaluation that would beat the best is confirmed on this many other episodes
   // before best.ckpt is replaced (learner/run_logs.hpp, BestEval); 0 = take it as it is.
   int confirm_episodes = 0;
+  // > 0: best.ckpt prefers an evaluation whose average steps to goal are at most this (one within
+  // beats one over it; learner/run_logs.hpp, BestEval), for a goal that counts steps; 0 = off.
+  double best_steps_limit = 0.0;
   double checkpoint_every_seconds = 600.0;
   double log_every_seconds = 10.0;
   // Warm start: a checkpoint whose networks a new run starts from (learner/checkpoint.hpp

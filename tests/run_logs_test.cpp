@@ -362,6 +362,29 @@ TEST(BestEval, ACandidateIsJudgedByItsConfirmation) {
   fs::remove_all(dir);
 }
 
+// train.best_steps_limit: an evaluation within the limit beats one over it whatever the rates;
+// on the same side the usual order holds; the limit holds for a resumed run told it again.
+TEST(BestEval, AStepsLimitPrefersResultsWithinIt) {
+  const fs::path dir = fresh_dir("best_limit");
+  const fs::path file = dir / "best_eval.txt";
+  {
+    BestEval best(file, "train", 75.0);
+    EXPECT_TRUE(best.offer(eval_of(0.0, 0.0, 1.0), 10));
+    EXPECT_TRUE(best.offer(eval_of(0.996, 79.6, 0.0), 20));   // successes beat none
+    EXPECT_FALSE(best.offer(eval_of(0.995, 79.0, 0.0), 30));  // both over: the rate decides
+    EXPECT_TRUE(best.offer(eval_of(0.985, 71.9, 0.0), 40));   // within beats over
+    EXPECT_FALSE(best.offer(eval_of(1.0, 76.0, 0.0), 50));    // over loses to within
+    EXPECT_TRUE(best.offer(eval_of(0.99, 74.0, 0.0), 60));    // both within: the rate decides
+    EXPECT_FALSE(best.offer(eval_of(0.99, 74.5, 0.0), 70));   // then the steps
+  }
+  BestEval resumed(file, "train", 75.0);
+  EXPECT_FALSE(resumed.offer(eval_of(0.999, 75.1, 0.0), 80));
+  EXPECT_TRUE(resumed.offer(eval_of(0.991, 75.0, 0.0), 90));  // the limit itself is within
+  BestEval unlimited(file);
+  EXPECT_TRUE(unlimited.offer(eval_of(0.999, 75.1, 0.0), 100));  // without a limit, rate first
+  fs::remove_all(dir);
+}
+
 TEST(ProgressBar, FormatsDurations) {
   EXPECT_EQ(ProgressBar::format_duration(0.2), "0s");
   EXPECT_EQ(ProgressBar::format_duration(59.4), "59s");
