@@ -59,13 +59,7 @@ EpsilonGreedy::EpsilonGreedy(const ActionSpace& space, const ExplorationConfig& 
     }
   }
   gates_ = config.gates;
-  // Every state must leave one action open: an ungated, unmasked one.
-  bool open = false;
-  for (int a = 0; a < num_actions_; ++a) {
-    open = open || (!masked_[static_cast<size_t>(a)] &&
-                    std::none_of(gates_.begin(), gates_.end(), [a](const ActionGate& g) { return g.action == a; }));
-  }
-  if (!open) {
+  if (!some_action_always_open(masked_, gates_)) {
     throw std::invalid_argument("exploration: every unmasked action is gated; leave one ungated");
   }
   for (const ParamSpec& p : space.params) {

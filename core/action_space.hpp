@@ -7,6 +7,7 @@
 // the actors and exploration never need to know which env they drive.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -56,6 +57,17 @@ struct ActionGate {
   int feature = -1;
   [[nodiscard]] bool shut(std::span<const float> obs) const { return !(obs[static_cast<size_t>(feature)] > 0.0F); }
 };
+
+// Whether some action is neither masked nor gated, so that every state leaves one to take.
+[[nodiscard]] inline bool some_action_always_open(const std::vector<bool>& masked, std::span<const ActionGate> gates) {
+  for (size_t a = 0; a < masked.size(); ++a) {
+    if (!masked[a] && std::none_of(gates.begin(), gates.end(),
+                                   [a](const ActionGate& g) { return g.action == static_cast<int>(a); })) {
+      return true;
+    }
+  }
+  return false;
+}
 
 // One chosen action: the discrete id and a view of the whole parameter vector (only the
 // entries the action owns are read). Non-owning; valid for the duration of a step() call.

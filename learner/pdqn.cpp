@@ -165,12 +165,7 @@ void Pdqn::set_gates(std::vector<ActionGate> gates) {
                                   "exploration.gated_actions");
     }
   }
-  bool open = false;
-  for (int k = 0; k < num_actions_; ++k) {
-    open = open || (!masked_[static_cast<size_t>(k)] &&
-                    std::none_of(gates.begin(), gates.end(), [k](const ActionGate& g) { return g.action == k; }));
-  }
-  if (!open) {
+  if (!some_action_always_open(masked_, gates)) {
     throw std::invalid_argument("P-DQN: every unmasked action is gated; leave one ungated");
   }
   gates_ = std::move(gates);

@@ -125,6 +125,23 @@ INSTANTIATE_TEST_SUITE_P(Pdqn, PdqnGradients,
                          ::testing::Combine(::testing::Bool(),
                                             ::testing::Values(BoundMethod::kZeroing, BoundMethod::kSquashing)));
 
+// The Q-network's input for transition j by hand: its state and stored parameters, where
+// MP-DQN keeps only the taken action's parameters.
+Eigen::MatrixXf q_input(const ActionSpace& space, const Batch& b, int j, int taken, bool multipass) {
+  Eigen::MatrixXf in(kObs + 3, 1);
+  in.col(0).head(kObs) = b.states.col(j);
+  in.col(0).tail(3) = b.actions.col(j).tail(3);
+  if (multipass) {
+    const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
+    for (int p = 0; p < 3; ++p) {
+      if (std::find(owned.begin(), owned.end(), p) == owned.end()) {
+        in(kObs + p, 0) = 0.0F;
+      }
+    }
+  }
+  return in;
+}
+
 // Both losses by hand from the networks' own forward passes: the taken action is the arg-max of
 // the stored scores over the unmasked actions (a masked action's high score is passed over), the
 // target's max skips the masked action, MP-DQN's Q sees only the taken action's parameters, and
@@ -148,18 +165,7 @@ TEST(Pdqn, LossesByHand) {
       if (j == 0) {
         ASSERT_EQ(taken, 0);
       }
-      Eigen::MatrixXf in(kObs + 3, 1);
-      in.col(0).head(kObs) = b.states.col(j);
-      in.col(0).tail(3) = b.actions.col(j).tail(3);
-      if (multipass) {
-        for (int p = 0; p < 3; ++p) {
-          const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
-          if (std::find(owned.begin(), owned.end(), p) == owned.end()) {
-            in(kObs + p, 0) = 0.0F;
-          }
-        }
-      }
-      const float q = pdqn.q_net().forward(in)(taken, 0);
+      const float q = pdqn.q_net().forward(q_input(space, b, j, taken, multipass))(taken, 0);
       pdqn.act({b.next_states.col(j).data(), kObs}, next, ActorCopy::kTarget);
       const float best = std::max(next[0], next[2]);
       const float y = b.rewards(j) + (b.terminal(j) > 0.5F ? 0.0F : 0.9F * best);
@@ -216,18 +222,7 @@ TEST(Pdqn, GatesByHand) {
       if (j < 2) {
         ASSERT_EQ(taken == 0, j == 1);
       }
-      Eigen::MatrixXf in(kObs + 3, 1);
-      in.col(0).head(kObs) = b.states.col(j);
-      in.col(0).tail(3) = b.actions.col(j).tail(3);
-      if (multipass) {
-        for (int p = 0; p < 3; ++p) {
-          const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
-          if (std::find(owned.begin(), owned.end(), p) == owned.end()) {
-            in(kObs + p, 0) = 0.0F;
-          }
-        }
-      }
-      const float q = pdqn.q_net().forward(in)(taken, 0);
+      const float q = pdqn.q_net().forward(q_input(space, b, j, taken, multipass))(taken, 0);
       pdqn.act({b.next_states.col(j).data(), kObs}, next, ActorCopy::kTarget);
       const float best = next_open ? std::max({next[0], next[1], next[2]}) : std::max(next[1], next[2]);
       const float y = b.rewards(j) + (b.terminal(j) > 0.5F ? 0.0F : 0.9F * best);
