@@ -125,8 +125,9 @@ void for_each_logged_episode(const std::filesystem::path& dir, const std::functi
 // with successes whose average steps to success are within the limit beats one over it, whatever
 // their rates; two on the same side compare as above. For a goal that counts both (HFO: scoring
 // at least .99 in at most 75 steps), an early pick that scores high but slowly does not hold
-// best.ckpt against later, faster candidates that score a little less. Persisted in a small text file (the run
-// directory's best_eval.txt) so that a resumed run keeps comparing against the best of its earlier part.
+// best.ckpt against later, faster candidates that score a little less. Persisted in a small text
+// file (the run directory's best_eval.txt) so that a resumed run keeps comparing against the best
+// of its earlier part.
 //
 // The maximum over a run's ~200 evaluations of 100 episodes is biased upwards: the policy that
 // scored 1.0 on one set of starts scores .93 on another. With `confirm`, an evaluation that
