@@ -86,7 +86,8 @@ void DdpgAlgorithm::warm_started() {
 }
 
 void register_ddpg_algorithm(AlgorithmRegistry& registry) {
-  registry.add({"ddpg", "DDPG with inverting, zeroing or squashing gradient bounds (Hausknecht & Stone 2016)",
+  registry.add({"ddpg",
+                "DDPG with inverting, zeroing or squashing gradient bounds (Hausknecht & Stone 2016)",
                 [](const AlgorithmArgs& a) {
                   if (!a.gates.empty()) {
                     throw std::invalid_argument(
@@ -95,7 +96,8 @@ void register_ddpg_algorithm(AlgorithmRegistry& registry) {
                         "train.algorithm = \"pdqn\" or \"mpdqn\", or leave exploration.gated_actions empty");
                   }
                   return std::make_unique<DdpgAlgorithm>(a.obs_dim, *a.space, *a.ddpg, a.seed, a.device);
-                }});
+                },
+                {}});  // no keys beyond ddpg.*
 }
 
 }  // namespace pamdp
