@@ -43,17 +43,6 @@ ParamAction no_op(std::array<float, param::kCount>& params) {
   return {kDash, params};
 }
 
-// Signed area test: p lies inside the triangle (a, b, c), either orientation.
-bool inside_triangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
-  const auto side = [](Vec2 o, Vec2 u, Vec2 q) { return (u.x - o.x) * (q.y - o.y) - (u.y - o.y) * (q.x - o.x); };
-  const double d1 = side(a, b, p);
-  const double d2 = side(b, c, p);
-  const double d3 = side(c, a, p);
-  const bool has_neg = d1 < 0 || d2 < 0 || d3 < 0;
-  const bool has_pos = d1 > 0 || d2 > 0 || d3 > 0;
-  return !(has_neg && has_pos);
-}
-
 TEST(HfoGoalie, OffByDefaultSo1v0Keeps58Features) {
   HfoEnv env;
   EXPECT_EQ(env.observation_size(), kNumAgentFeatures);
