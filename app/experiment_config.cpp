@@ -119,6 +119,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.integer("train.eval_episodes", c.train.eval_episodes, 0, 1000000);
   v.integer("train.confirm_episodes", c.train.confirm_episodes, 0, 1000000);
   v.real("train.best_steps_limit", c.train.best_steps_limit, 0.0, 1e9);
+  v.boolean("train.recheck_best", c.train.recheck_best);
   v.real("train.checkpoint_every_seconds", c.train.checkpoint_every_seconds, 0.0, 1e9);
   v.real("train.log_every_seconds", c.train.log_every_seconds, 0.0, 1e9);
   v.text_or_empty("train.init_from", c.train.init_from);

@@ -81,6 +81,10 @@ void run_learner(const LearnerCliOptions& o) {
   // the replay shards: their rows stay, and the next episodes are numbered after them.
   spec.keeps_episodes_after_checkpoint = true;
   TrainingRun run(spec, *algorithm, *env, *eval_env);
+  // best.ckpt played again (train.recheck_best): the run's own learner, its weights from the file.
+  run.make_incumbent = [&] {
+    return make_learner(c, env->observation_size(), env->action_space(), c.seed, UpdateDevice::kCpu);
+  };
   const CheckpointMeta meta = run.start(resume);
 
   LearnerServerConfig sc;

@@ -171,6 +171,8 @@ TrainSummary Trainer::run() {
       save_replay_snapshot((dir / "demo_replay.bin").string(), *demo_replay_);
     }
   };
+  // best.ckpt played again (train.recheck_best): the run's own learner, its weights from the file.
+  run_.make_incumbent = [this] { return make_learner(c_, obs_dim_, space_, c_.seed, UpdateDevice::kCpu); };
   const CheckpointMeta meta = run_.start(o_.resume);
   if (o_.resume) {
     const std::string ck = (dir / "checkpoint.ckpt").string();

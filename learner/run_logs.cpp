@@ -273,15 +273,17 @@ BestEval::BestEval(fs::path file, std::string role, double steps_limit)
   std::ifstream in(file_);
   EvalResult r;
   if (in >> r.goal_rate >> r.avg_steps_to_goal >> r.avg_return) {
+    int64_t updates = 0;
+    int episodes = 0;
+    if (in >> updates >> episodes) {  // both written since the file had a comment line
+      best_updates_ = updates;
+      r.episodes = episodes;
+    }
     best_ = r;
   }
 }
 
-bool BestEval::beats_best(const EvalResult& r) const {
-  if (!best_) {
-    return true;
-  }
-  const EvalResult& b = *best_;
+bool BestEval::beats(const EvalResult& r, const EvalResult& b) const {
   if (steps_limit_ > 0.0) {
     const auto within = [this](const EvalResult& e) {
       return e.goal_rate > 0.0 && e.avg_steps_to_goal <= steps_limit_;
@@ -299,8 +301,39 @@ bool BestEval::beats_best(const EvalResult& r) const {
   return r.avg_return > b.avg_return;
 }
 
-bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm,
-                     EvalResult* kept) {
+EvalResult pooled(const EvalResult& a, const EvalResult& b) {
+  if (a.episodes <= 0) {
+    return b;
+  }
+  const double na = a.episodes;
+  const double nb = b.episodes;
+  const double goals_a = a.goal_rate * na;
+  const double goals_b = b.goal_rate * nb;
+  EvalResult p;
+  p.episodes = a.episodes + b.episodes;
+  p.goal_rate = (goals_a + goals_b) / (na + nb);
+  p.avg_steps_to_goal = goals_a + goals_b > 0.0
+                            ? (a.avg_steps_to_goal * goals_a + b.avg_steps_to_goal * goals_b) / (goals_a + goals_b)
+                            : 0.0;
+  p.avg_return = (a.avg_return * na + b.avg_return * nb) / (na + nb);
+  p.avg_steps = (a.avg_steps * na + b.avg_steps * nb) / (na + nb);
+  return p;
+}
+
+void BestEval::write() const {
+  const EvalResult& b = *best_;
+  std::ostringstream text;
+  text.precision(17);
+  text << b.goal_rate << ' ' << b.avg_steps_to_goal << ' ' << b.avg_return << ' ' << best_updates_ << ' ' << b.episodes
+       << '\n'
+       << "# success rate, avg steps to success, avg return, updates, episodes of the best greedy evaluation "
+          "(best.ckpt)\n";
+  const std::string s = text.str();
+  write_file_atomically(file_.string(), s.data(), s.size());
+}
+
+bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm, EvalResult* kept,
+                     const std::function<EvalResult()>& recheck) {
   if (!beats_best(r)) {
     return false;
   }
@@ -313,23 +346,35 @@ bool BestEval::offer(const EvalResult& r, int64_t updates, const std::function<E
     *kept = result;
   }
   if (confirming) {
-    const bool better = beats_best(result);
-    log::info("{}: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}: {}",
+    bool better = beats_best(result);
+    std::string against;
+    // The kept policy on the challenger's starts: only a kept figure with successes is worth
+    // replaying (as above, one without would run every episode to the time limit).
+    if (better && recheck && best_->goal_rate > 0.0) {
+      const EvalResult incumbent = recheck();
+      better = beats(result, incumbent);
+      char text[160];
+      std::snprintf(text, sizeof text, ", best.ckpt (from %lld updates) %.3f / %.1f on the same starts",
+                    static_cast<long long>(best_updates_), incumbent.goal_rate, incumbent.avg_steps_to_goal);
+      against = text;
+      if (!better) {
+        best_ = pooled(*best_, incumbent);
+        write();
+        std::snprintf(text, sizeof text, ", %.3f / %.1f over its %d episodes", best_->goal_rate,
+                      best_->avg_steps_to_goal, best_->episodes);
+        against += text;
+      }
+    }
+    log::info("{}: candidate best at {} updates: {:.3f} on {} episodes, confirmed {:.3f} / {:.1f} steps on {}{}: {}",
               role_, updates, r.goal_rate, r.episodes, result.goal_rate, result.avg_steps_to_goal, result.episodes,
-              better ? "new best.ckpt" : "kept the old one");
+              against, better ? "new best.ckpt" : "kept the old one");
     if (!better) {
       return false;
     }
   }
   best_ = result;
-  std::ostringstream text;
-  text.precision(17);
-  text << result.goal_rate << ' ' << result.avg_steps_to_goal << ' ' << result.avg_return << ' ' << updates << ' '
-       << result.episodes << '\n'
-       << "# success rate, avg steps to success, avg return, updates, episodes of the best greedy evaluation "
-          "(best.ckpt)\n";
-  const std::string s = text.str();
-  write_file_atomically(file_.string(), s.data(), s.size());
+  best_updates_ = updates;
+  write();
   return true;
 }
 

@@ -134,6 +134,17 @@ void for_each_logged_episode(const std::filesystem::path& dir, const std::functi
 // would beat the best is only a candidate: confirm() evaluates the same policy again (on more,
 // independent episodes) and that result is what is compared and kept, so the figure in
 // best_eval.txt is the candidate's unbiased score, not its lucky draw.
+//
+// That figure is unbiased for the candidate, not for the winner: the best of a run's ~30
+// confirmations still overstates itself (a best.ckpt confirmed at .995 on its run's starts scored
+// .986 on 3,000 others, docs/results.md issue 29), and each challenger is compared against that
+// optimistic figure on starts of its own. With `recheck` as well (train.recheck_best), a
+// confirmed challenger that beats the kept figure is compared once more, against the kept policy
+// played on the challenger's own confirmation starts (a paired comparison, so the luck of one set
+// of starts does not decide). The challenger wins only if it beats that result too. When it
+// loses, the kept figure becomes the pooled result of all the kept policy's evaluations so far,
+// so that figure falls back toward the policy's true score. The figure in best_eval.txt is then
+// the pooled one, over its stated episodes.
 class BestEval {
  public:
   // `role` ("train", "learner") begins the log line of each confirmation.
@@ -143,17 +154,30 @@ class BestEval {
   // then the file is rewritten (atomically) with it and `updates`. `kept`, when given, receives
   // the result that was compared (the confirmation's, when one ran). A confirmation is logged
   // with both results and the verdict. A result without successes is kept unconfirmed.
+  // `recheck`, when given, plays the kept policy on the confirmation's starts (see above); it is
+  // called only after a confirmation that beats the kept figure, and only when that figure has
+  // successes. A lost recheck rewrites the file with the pooled figure of the kept policy.
   bool offer(const EvalResult& r, int64_t updates, const std::function<EvalResult()>& confirm = {},
-             EvalResult* kept = nullptr);
+             EvalResult* kept = nullptr, const std::function<EvalResult()>& recheck = {});
   [[nodiscard]] const std::optional<EvalResult>& best() const { return best_; }
+  // The updates at which the kept policy was evaluated (0 when none or not recorded).
+  [[nodiscard]] int64_t best_updates() const { return best_updates_; }
 
  private:
-  [[nodiscard]] bool beats_best(const EvalResult& r) const;
+  [[nodiscard]] bool beats(const EvalResult& r, const EvalResult& b) const;
+  [[nodiscard]] bool beats_best(const EvalResult& r) const { return !best_ || beats(r, *best_); }
+  void write() const;
 
   std::filesystem::path file_;
   std::string role_;
   double steps_limit_;
   std::optional<EvalResult> best_;
+  int64_t best_updates_ = 0;
 };
+
+// Two evaluations of one policy as one: rates and returns weighted by episodes, steps to goal by
+// successes. An `a` without a recorded episode count (best_eval.txt written before it held one)
+// adds nothing: the result is `b`.
+EvalResult pooled(const EvalResult& a, const EvalResult& b);
 
 }  // namespace pamdp

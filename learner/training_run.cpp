@@ -66,6 +66,9 @@ void TrainingRun::record_resumed_config() {
 }
 
 CheckpointMeta TrainingRun::start(bool resume) {
+  if (spec_.loop.recheck_best && !make_incumbent) {
+    throw std::logic_error("TrainingRun: train.recheck_best needs make_incumbent");
+  }
   fs::create_directories(spec_.dir);
   CheckpointMeta meta;
   if (resume) {
@@ -114,6 +117,9 @@ CheckpointMeta TrainingRun::start(bool resume) {
     }
   }
   best_.emplace(spec_.dir / "best_eval.txt", spec_.role, spec_.loop.best_steps_limit);
+  if (spec_.loop.recheck_best && resume && fs::exists(spec_.dir / "best.ckpt")) {
+    load_incumbent();
+  }
   start_ = std::chrono::steady_clock::now();
   last_checkpoint_ = last_row_ = base_seconds_;
   row_updates_ = algorithm_.updates();
@@ -191,11 +197,28 @@ void TrainingRun::evaluate() {
       return pamdp::evaluate(eval_env_, policy, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
     };
   }
+  std::function<EvalResult()> recheck;
+  if (loop.recheck_best && loop.confirm_episodes > 0 && incumbent_) {
+    recheck = [&] {
+      GreedyActorPolicy kept(*incumbent_, eval_env_.action_space(), spec_.exploration, incumbent_->evaluated_copy());
+      return pamdp::evaluate(eval_env_, kept, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
+    };
+  }
   // The actor (with everything else) of the best greedy evaluation so far: what `pamdp eval
   // --checkpoint RUN/best.ckpt` should be given when the final policy is worse than an earlier one.
-  if (best_->offer(*last_eval_, at, confirm)) {
+  if (best_->offer(*last_eval_, at, confirm, nullptr, recheck)) {
     save_to(spec_.dir / "best.ckpt");
+    if (loop.recheck_best) {
+      load_incumbent();
+    }
   }
+}
+
+void TrainingRun::load_incumbent() {
+  if (!incumbent_) {
+    incumbent_ = make_incumbent();
+  }
+  load_checkpoint((spec_.dir / "best.ckpt").string(), *incumbent_);
 }
 
 MetricsRow TrainingRun::next_metrics_row() {

@@ -24,6 +24,7 @@
 #include <deque>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -51,6 +52,10 @@ struct TrainLoopConfig {
   // > 0: an evaluation that would beat the best is confirmed on this many other episodes
   // before best.ckpt is replaced (learner/run_logs.hpp, BestEval); 0 = take it as it is.
   int confirm_episodes = 0;
+  // With confirm_episodes > 0: a confirmed candidate that beats best.ckpt's figure must also beat
+  // best.ckpt's policy played on the candidate's confirmation starts; when it does not, best.ckpt's
+  // figure becomes the pooled result of its evaluations (learner/run_logs.hpp, BestEval).
+  bool recheck_best = false;
   // > 0: best.ckpt prefers an evaluation whose average steps to goal are at most this (one within
   // beats one over it; learner/run_logs.hpp, BestEval), for a goal that counts steps; 0 = off.
   double best_steps_limit = 0.0;
@@ -124,6 +129,10 @@ class TrainingRun {
   std::function<void()> before_checkpoint;
   // Every evaluation's result (the live metrics).
   std::function<void(const EvalResult&)> on_eval;
+  // Builds an algorithm of the run's own config and shapes, updating on the CPU, that best.ckpt
+  // is loaded into to be played again (train.recheck_best). Required with train.recheck_best
+  // (start() throws std::logic_error without it); never called otherwise.
+  std::function<std::unique_ptr<Algorithm>()> make_incumbent;
 
   // Env steps played, counted as they are played (`train`) or when their episode is reported
   // (`learner`): the rows' env_steps.
@@ -168,6 +177,8 @@ class TrainingRun {
   [[nodiscard]] CheckpointMeta meta_now();
   void record_resumed_config();
   void save_to(const std::filesystem::path& file);
+  // Loads dir/best.ckpt into incumbent_ (built on first use).
+  void load_incumbent();
 
   RunSpec spec_;
   Algorithm& algorithm_;
@@ -175,6 +186,7 @@ class TrainingRun {
   Env& eval_env_;
   std::optional<RunLogs> logs_;
   std::optional<BestEval> best_;
+  std::unique_ptr<Algorithm> incumbent_;  // best.ckpt's policy (train.recheck_best)
   RecentEpisodes recent_;
   UpdateStats last_stats_;
   std::optional<EvalResult> last_eval_;

@@ -385,6 +385,84 @@ TEST(BestEval, AStepsLimitPrefersResultsWithinIt) {
   fs::remove_all(dir);
 }
 
+// train.recheck_best: a confirmed challenger must also beat the kept policy played on the
+// challenger's starts; a lost recheck pools the kept policy's evaluations, by hand below.
+TEST(BestEval, ARecheckPlaysTheKeptPolicyOnTheChallengersStartsAndPoolsItsFigures) {
+  const fs::path dir = fresh_dir("best_recheck");
+  const fs::path file = dir / "best_eval.txt";
+  const auto on_1000 = [](double rate, double steps, double ret) {
+    EvalResult r = eval_of(rate, steps, ret);
+    r.episodes = 1000;
+    return r;
+  };
+  int rechecks = 0;
+  const auto returning = [&rechecks](EvalResult r) {
+    return std::function<EvalResult()>([&rechecks, r] {
+      ++rechecks;
+      return r;
+    });
+  };
+  const auto confirmed = [](EvalResult r) { return std::function<EvalResult()>([r] { return r; }); };
+  {
+    BestEval best(file, "train", 75.0);
+    // Nothing kept yet, then only a screen without successes: nothing to replay.
+    EXPECT_TRUE(
+        best.offer(eval_of(0.0, 0.0, 1.0), 5, confirmed(on_1000(0, 0, 0)), nullptr, returning(on_1000(1.0, 1.0, 1.0))));
+    EXPECT_TRUE(best.offer(eval_of(1.0, 70.0, 0.0), 10, confirmed(on_1000(0.995, 72.0, 2.0)), nullptr,
+                           returning(on_1000(1.0, 1.0, 1.0))));
+    EXPECT_EQ(rechecks, 0);
+    EXPECT_EQ(best.best_updates(), 10);
+    // A challenger confirmed at .997 beats the kept .995, but the kept policy scores .999 on the
+    // challenger's starts: kept, and its figure pools .995 and .999 on 1,000 each.
+    EvalResult kept;
+    EXPECT_FALSE(best.offer(eval_of(1.0, 70.0, 0.0), 20, confirmed(on_1000(0.997, 71.0, 3.0)), &kept,
+                            returning(on_1000(0.999, 73.0, 4.0))));
+    EXPECT_EQ(rechecks, 1);
+    EXPECT_DOUBLE_EQ(kept.goal_rate, 0.997);  // what was compared: the confirmation
+    ASSERT_TRUE(best.best().has_value());
+    EXPECT_EQ(best.best()->episodes, 2000);
+    EXPECT_NEAR(best.best()->goal_rate, 0.997, 1e-12);                                       // (995 + 999) / 2000
+    EXPECT_NEAR(best.best()->avg_steps_to_goal, (72.0 * 995 + 73.0 * 999) / 1994.0, 1e-12);  // by goals
+    EXPECT_NEAR(best.best()->avg_return, 3.0, 1e-12);
+    EXPECT_EQ(best.best_updates(), 10);  // still the kept policy's
+    // A challenger confirmed at .998 beats the pooled .997; the kept one scores .990 on its
+    // starts: the challenger wins, with its own confirmation as the figure.
+    EXPECT_TRUE(best.offer(eval_of(1.0, 70.0, 0.0), 30, confirmed(on_1000(0.998, 74.0, 5.0)), nullptr,
+                           returning(on_1000(0.990, 70.0, 1.0))));
+    EXPECT_EQ(rechecks, 2);
+    EXPECT_DOUBLE_EQ(best.best()->goal_rate, 0.998);
+    EXPECT_EQ(best.best()->episodes, 1000);
+    // A confirmation that does not beat the kept figure is not rechecked.
+    EXPECT_FALSE(best.offer(eval_of(1.0, 70.0, 0.0), 40, confirmed(on_1000(0.996, 70.0, 5.0)), nullptr,
+                            returning(on_1000(0.0, 0.0, 0.0))));
+    EXPECT_EQ(rechecks, 2);
+    // The recheck compares as everything else does: at the same rate, fewer steps win.
+    EXPECT_FALSE(best.offer(eval_of(1.0, 70.0, 0.0), 50, confirmed(on_1000(0.999, 74.9, 5.0)), nullptr,
+                            returning(on_1000(0.999, 70.0, 0.0))));
+    EXPECT_EQ(rechecks, 3);
+    EXPECT_EQ(best.best()->episodes, 2000);
+    EXPECT_NEAR(best.best()->goal_rate, (998.0 + 999.0) / 2000.0, 1e-12);
+  }
+  // The pooled figure, its updates and its episodes survive a restart.
+  BestEval resumed(file, "train", 75.0);
+  ASSERT_TRUE(resumed.best().has_value());
+  EXPECT_NEAR(resumed.best()->goal_rate, (998.0 + 999.0) / 2000.0, 1e-12);
+  EXPECT_EQ(resumed.best()->episodes, 2000);
+  EXPECT_EQ(resumed.best_updates(), 30);
+  fs::remove_all(dir);
+}
+
+// A figure without an episode count (best_eval.txt before it held one) pools as the new result.
+TEST(BestEval, PoolingWithoutAnEpisodeCountTakesTheNewResult) {
+  EvalResult old = eval_of(0.99, 70.0, 1.0);
+  EvalResult fresh = eval_of(0.98, 72.0, 2.0);
+  fresh.episodes = 1000;
+  const EvalResult p = pooled(old, fresh);
+  EXPECT_EQ(p.episodes, 1000);
+  EXPECT_DOUBLE_EQ(p.goal_rate, 0.98);
+  EXPECT_DOUBLE_EQ(p.avg_steps_to_goal, 72.0);
+}
+
 TEST(ProgressBar, FormatsDurations) {
   EXPECT_EQ(ProgressBar::format_duration(0.2), "0s");
   EXPECT_EQ(ProgressBar::format_duration(59.4), "59s");

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -157,6 +159,53 @@ void run_past_a_checkpoint(const fs::path& dir, Learner& l) {
   run.record_env_steps(6);
   run.record_episode({toy::ReachStopEnv::kWrongStop, -1.0, 6, 1, 3, false});
   run.logs().flush();
+}
+
+// train.recheck_best: the run keeps best.ckpt's policy loaded to replay it, from the file each
+// time best.ckpt is written, and again when a run resumes.
+TEST(TrainingRun, RecheckBestKeepsBestCkptsPolicyLoaded) {
+  const fs::path dir = fresh_dir("recheck");
+  Learner l;
+  RunSpec spec = spec_in(dir, false);
+  spec.loop.recheck_best = true;
+  spec.loop.confirm_episodes = 4;
+  {
+    TrainingRun run(spec, l.ddpg, l.env, l.eval_env);
+    EXPECT_THROW(run.start(false), std::logic_error);  // the caller forgot make_incumbent
+  }
+  int built = 0;
+  Algorithm* incumbent = nullptr;
+  const auto make = [&]() -> std::unique_ptr<Algorithm> {
+    ++built;
+    auto a = std::make_unique<DdpgAlgorithm>(l.env.observation_size(), l.env.action_space(), tiny_config(), 99,
+                                             UpdateDevice::kCpu);
+    incumbent = a.get();
+    return a;
+  };
+  const std::vector<float> obs(static_cast<size_t>(l.env.observation_size()), 0.25F);
+  const auto output_of = [&obs](Algorithm& a) {
+    std::vector<float> out(static_cast<size_t>(a.output_width()));
+    a.act(obs, out, a.evaluated_copy());
+    return out;
+  };
+  {
+    TrainingRun run(spec, l.ddpg, l.env, l.eval_env);
+    run.make_incumbent = make;
+    run.start(false);
+    EXPECT_EQ(built, 0);
+    l.update(run, 5);
+    ASSERT_TRUE(run.evaluate_if_due());  // the first evaluation is the best so far: best.ckpt
+    EXPECT_EQ(built, 1);
+    ASSERT_NE(incumbent, nullptr);
+    EXPECT_EQ(output_of(*incumbent), output_of(l.ddpg));  // the run's policy, as written
+    run.save();
+  }
+  TrainingRun resumed(spec, l.ddpg, l.env, l.eval_env);
+  resumed.make_incumbent = make;
+  resumed.start(true);
+  EXPECT_EQ(built, 2);  // best.ckpt read back
+  EXPECT_EQ(output_of(*incumbent), output_of(l.ddpg));
+  fs::remove_all(dir);
 }
 
 TEST(TrainingRun, AReplayingResumeDropsTheEpisodesAfterItsCheckpoint) {
