@@ -191,17 +191,19 @@ void TrainingRun::evaluate() {
   if (on_eval) {
     on_eval(*last_eval_);
   }
+  // The confirmation's starts: the candidate plays them, and best.ckpt's policy replays them.
+  const auto on_confirmation_starts = [&](Policy& p) {
+    return pamdp::evaluate(eval_env_, p, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
+  };
   std::function<EvalResult()> confirm;
   if (loop.confirm_episodes > 0) {
-    confirm = [&] {
-      return pamdp::evaluate(eval_env_, policy, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
-    };
+    confirm = [&] { return on_confirmation_starts(policy); };
   }
   std::function<EvalResult()> recheck;
   if (loop.recheck_best && loop.confirm_episodes > 0 && incumbent_) {
     recheck = [&] {
       GreedyActorPolicy kept(*incumbent_, eval_env_.action_space(), spec_.exploration, incumbent_->evaluated_copy());
-      return pamdp::evaluate(eval_env_, kept, loop.confirm_episodes, confirmation_seed(spec_.seed, at));
+      return on_confirmation_starts(kept);
     };
   }
   // The actor (with everything else) of the best greedy evaluation so far: what `pamdp eval
