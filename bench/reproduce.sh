@@ -3,13 +3,13 @@
 # anyone can check a results claim on their own machine:
 #
 #   bench/reproduce.sh [--config FILE] [--seed S] [--run-dir DIR] [--episodes N]
-#                      [--checkpoint best|final] [--set key=value ...]
+#                      [--checkpoint best|final] [--eval-seed E] [--set key=value ...]
 #
 # Trains with `pamdp train` (default deploy/configs/fast.toml, seed 1, run directory
 # runs/reproduce-<config>-seed<S>; an existing one is resumed), evaluates the best greedy
 # checkpoint (best.ckpt, else checkpoint.ckpt; --checkpoint final: the final policy,
 # checkpoint.ckpt, MP-DQN's protocol) on N episodes (default 100, the paper's protocol) with
-# `pamdp eval --seed 1`, and prints:
+# `pamdp eval --seed E` (default 1; docs/results.md scores final policies with 7), and prints:
 #
 #   config, seed, updates, episodes, wall-clock, first update/hour at which the goal rate over
 #   the last 100 training episodes reached .90 and .96, scoring rate, average steps to goal,
@@ -25,9 +25,10 @@ seed=1
 run_dir=""
 episodes=100
 which=best
+eval_seed=1
 sets=()
 
-usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "reproduce: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -38,6 +39,7 @@ while [[ $# -gt 0 ]]; do
     --run-dir) need_value "$@"; run_dir=$2; shift 2 ;;
     --episodes) need_value "$@"; episodes=$2; shift 2 ;;
     --checkpoint) need_value "$@"; which=$2; shift 2 ;;
+    --eval-seed) need_value "$@"; eval_seed=$2; shift 2 ;;
     --set) need_value "$@"; sets+=(--set "$2"); shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) die "unknown argument '$1' (see --help)" ;;
@@ -47,6 +49,7 @@ done
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
 [[ $episodes =~ ^[1-9][0-9]*$ ]] || die "--episodes must be a positive integer, not '$episodes'"
 [[ $which == best || $which == final ]] || die "--checkpoint takes best or final, not '$which'"
+[[ $eval_seed =~ ^[0-9]+$ ]] || die "--eval-seed must be a non-negative integer, not '$eval_seed'"
 
 bin=${PAMDP_BIN:-build/bin/pamdp}
 if [[ ! -x $bin ]]; then
@@ -66,7 +69,7 @@ fi
 
 checkpoint=$run_dir/checkpoint.ckpt
 [[ $which == best && -f $run_dir/best.ckpt ]] && checkpoint=$run_dir/best.ckpt
-result=$("$bin" eval --checkpoint "$checkpoint" --episodes "$episodes" --seed 1 --json | tail -n 1)
+result=$("$bin" eval --checkpoint "$checkpoint" --episodes "$episodes" --seed "$eval_seed" --json | tail -n 1)
 
 # The first metrics row at which the training goal rate (last 100 episodes) reached a level.
 first_reach() {

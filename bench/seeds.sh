@@ -4,15 +4,16 @@
 #
 #   bench/seeds.sh [--config FILE] [--seeds 1,2,3,4,5] [--jobs 2] [--episodes N]
 #                  [--checkpoint best|final] [--target-rate R] [--target-steps S] [--out DIR]
-#                  [--set key=value ...]
+#                  [--eval-seed E] [--set key=value ...]
 #
 # Defaults: deploy/configs/fast.toml, seeds 1-5, 2 at a time (one per core), evaluation on 1,000
 # episodes of best.ckpt (--checkpoint final: of the final policy, MP-DQN's protocol, as for the
-# presets deploy/configs/<task>-<learner>.toml), target: scoring >= .99 with <= 80 average steps
-# to goal (issue 7); the mean scoring and mean return over the seeds follow the rows. Run directories
-# are DIR/seedS (default DIR runs/seeds-<config>; an existing one is resumed) with each seed's
-# log beside it. Exit status 0 whether or not the target is met; 2 on a usage error, 1 when a
-# seed's training or evaluation failed (its log says why).
+# presets deploy/configs/<task>-<learner>.toml) with `pamdp eval --seed 1` (--eval-seed E: with
+# seed E; docs/results.md scores final policies with 7), target: scoring >= .99 with <= 80
+# average steps to goal (issue 7); the mean scoring and mean return over the seeds follow the
+# rows. Run directories are DIR/seedS (default DIR runs/seeds-<config>; an existing one is
+# resumed) with each seed's log beside it. Exit status 0 whether or not the target is met; 2 on
+# a usage error, 1 when a seed's training or evaluation failed (its log says why).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -22,12 +23,13 @@ seeds=1,2,3,4,5
 jobs=2
 episodes=1000
 which=best
+eval_seed=1
 target_rate=0.99
 target_steps=80
 out=""
 sets=()
 
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "seeds: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -38,6 +40,7 @@ while [[ $# -gt 0 ]]; do
     --jobs) need_value "$@"; jobs=$2; shift 2 ;;
     --episodes) need_value "$@"; episodes=$2; shift 2 ;;
     --checkpoint) need_value "$@"; which=$2; shift 2 ;;
+    --eval-seed) need_value "$@"; eval_seed=$2; shift 2 ;;
     --target-rate) need_value "$@"; target_rate=$2; shift 2 ;;
     --target-steps) need_value "$@"; target_steps=$2; shift 2 ;;
     --out) need_value "$@"; out=$2; shift 2 ;;
@@ -51,6 +54,7 @@ done
 [[ $jobs =~ ^[1-9][0-9]*$ ]] || die "--jobs must be a positive integer, not '$jobs'"
 [[ $episodes =~ ^[1-9][0-9]*$ ]] || die "--episodes must be a positive integer, not '$episodes'"
 [[ $which == best || $which == final ]] || die "--checkpoint takes best or final, not '$which'"
+[[ $eval_seed =~ ^[0-9]+$ ]] || die "--eval-seed must be a non-negative integer, not '$eval_seed'"
 [[ $target_rate =~ ^(0(\.[0-9]+)?|1(\.0+)?)$ ]] || die "--target-rate must be in [0, 1], not '$target_rate'"
 [[ $target_steps =~ ^[0-9]+(\.[0-9]+)?$ ]] || die "--target-steps must be a non-negative number, not '$target_steps'"
 
@@ -66,7 +70,7 @@ for seed in "${seed_list[@]}"; do
   done
   echo "seeds: training seed $seed (log $out/seed$seed.log)" >&2
   bash bench/reproduce.sh --config "$config" --seed "$seed" --run-dir "$out/seed$seed" --episodes "$episodes" \
-    --checkpoint "$which" "${sets[@]}" >"$out/seed$seed.log" 2>&1 &
+    --checkpoint "$which" --eval-seed "$eval_seed" "${sets[@]}" >"$out/seed$seed.log" 2>&1 &
   pids+=($!)
 done
 failed=0

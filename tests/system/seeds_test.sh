@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # bench/seeds.sh end to end on the toy task: two seeds trained side by side, evaluated, one table
 # row each, and the verdict counts them (ReachStop is solved by every seed in ~1 s); a target no
-# agent can meet is counted as missed; a bad --seeds list is refused by name.
+# agent can meet is counted as missed; --eval-seed scores with that evaluation seed; bad --seeds and
+# --eval-seed values are refused by name.
 #   seeds_test.sh PAMDP_BIN SOURCE_DIR
 set -euo pipefail
 bin=$1
@@ -30,6 +31,17 @@ grep -q '^| config | .*scoring (200 ep, final) .*| mean return |' <<<"$out" || f
 # AVX2 machine; the best checkpoints above are.)
 grep -qE '^mean over 2 seeds \(final checkpoints\): scoring (0\.[5-9][0-9]*|1\.000), return ' <<<"$out" ||
   fail "no mean over the seeds: $out"
+
+# --eval-seed: the row and JSON of each seed are `pamdp eval --seed E` of its checkpoint.
+out=$(PAMDP_BIN=$bin bash "$src/bench/seeds.sh" --config "$src/deploy/configs/reach_stop.toml" --seeds 1,2 \
+  --episodes 200 --checkpoint final --eval-seed 7 --out "$work/a" 2>/dev/null) || fail "--eval-seed 7 failed: $out"
+want=$("$bin" eval --checkpoint "$work/a/seed1/checkpoint.ckpt" --episodes 200 --seed 7 --json 2>/dev/null | tail -n 1)
+[[ $(tail -n 1 "$work/a/seed1.log") == "$want" ]] ||
+  fail "seed 1 was not scored with eval --seed 7: $(tail -n 1 "$work/a/seed1.log") against $want"
+if err=$(bash "$src/bench/seeds.sh" --eval-seed x 2>&1); then
+  fail "--eval-seed x accepted"
+fi
+grep -q -- "--eval-seed" <<<"$err" || fail "the error does not name --eval-seed: $err"
 
 if err=$(bash "$src/bench/seeds.sh" --checkpoint last 2>&1); then
   fail "--checkpoint last accepted"
