@@ -332,6 +332,26 @@ TEST_F(HfoReward, OutOfBoundsPaysZero) {
   EXPECT_EQ(r.reward, 0.0F);
 }
 
+// env.out_of_bounds_penalty = 4: the same out-of-bounds episode pays -4 on its terminal step and
+// nothing else changes; a goal still pays exactly 5.
+TEST(HfoRewardPenalty, OutOfBoundsPaysMinusThePenalty) {
+  HfoEnv env(quiet_config(), false, 4);
+  std::array<float, 58> obs{};
+  std::array<float, param::kCount> params{};
+  const auto idle = [&] { return env.step(ParamAction{kTurn, params}, obs); };
+  env.set_state(make_agent({30.0, 5.0}), BallState{{1.0, 0.0}, {-2.0, 0.0}}, obs);
+  StepResult r = idle();
+  EXPECT_EQ(r.status, kInGame);
+  EXPECT_EQ(r.reward, 0.0F);
+  r = idle();
+  EXPECT_EQ(r.status, kOutOfBounds);
+  EXPECT_EQ(r.reward, -4.0F);
+  env.set_state(make_agent({40.0, 10.0}), BallState{{52.0, 0.0}, {1.0, 0.0}}, obs);
+  r = idle();
+  EXPECT_EQ(r.status, kGoal);
+  EXPECT_EQ(r.reward, 5.0F);
+}
+
 // A new episode restarts the reward: after a goal, set_state again and the first transition is
 // again unshaped even though the agent moves 1 m.
 TEST_F(HfoReward, ResetRestartsShaping) {

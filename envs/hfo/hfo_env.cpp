@@ -70,6 +70,9 @@ float ShapedReward::operator()(std::span<const float> features, int status) {
     d_prox = d_kick = d_dist = 0.0;
   }
   double r = d_prox - 3.0 * d_dist + (status == kGoal ? 5.0 : 0.0);
+  if (status == kOutOfBounds) {
+    r -= out_of_bounds_penalty_;
+  }
   if (d_kick >= 1.0 && !got_kick_) {
     r += 1.0;
     got_kick_ = true;
@@ -78,7 +81,8 @@ float ShapedReward::operator()(std::span<const float> features, int status) {
   return static_cast<float>(r);
 }
 
-HfoEnv::HfoEnv(const SoccerSimConfig& config, bool shoot_action) : sim_(config), shoot_(shoot_action) {}
+HfoEnv::HfoEnv(const SoccerSimConfig& config, bool shoot_action, int out_of_bounds_penalty)
+    : sim_(config), reward_(out_of_bounds_penalty), shoot_(shoot_action) {}
 
 std::span<const int> HfoEnv::outcomes() const {
   static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};

@@ -40,9 +40,13 @@ const ActionSpace& hfo_action_space(bool shoot = false);
 
 // The shaped reward of dqn-hfo, computed from consecutive feature vectors (reference §6.2):
 // no shaping on the first transition of an episode nor on the terminal one, kickable bonus
-// once per episode, 5 for a goal.
+// once per episode, 5 for a goal. Beyond dqn-hfo, out_of_bounds_penalty is subtracted on the
+// OUT_OF_BOUNDS transition (env.out_of_bounds_penalty, default 0 = dqn-hfo's reward): the shaping
+// pays a shot's progress as the ball rolls, so a shot that goes out keeps most of the return of
+// one that scores (docs/results.md, "Where the remaining failures are").
 class ShapedReward {
  public:
+  explicit ShapedReward(int out_of_bounds_penalty = 0) : out_of_bounds_penalty_(out_of_bounds_penalty) {}
   void reset() {
     steps_ = 0;
     got_kick_ = false;
@@ -57,14 +61,16 @@ class ShapedReward {
   };
   static Snapshot snapshot(std::span<const float> f);
   Snapshot prev_;
+  int out_of_bounds_penalty_ = 0;
   int steps_ = 0;
   bool got_kick_ = false;
 };
 
 class HfoEnv final : public Env {
  public:
-  // shoot_action: the action space with SHOOT (env.shoot_action).
-  explicit HfoEnv(const SoccerSimConfig& config = {}, bool shoot_action = false);
+  // shoot_action: the action space with SHOOT (env.shoot_action); out_of_bounds_penalty: the
+  // reward's (env.out_of_bounds_penalty, ShapedReward).
+  explicit HfoEnv(const SoccerSimConfig& config = {}, bool shoot_action = false, int out_of_bounds_penalty = 0);
 
   [[nodiscard]] std::string_view name() const override { return "hfo"; }
   [[nodiscard]] const ActionSpace& action_space() const override { return hfo_action_space(shoot_); }

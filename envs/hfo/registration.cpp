@@ -116,8 +116,12 @@ void register_hfo_env(EnvRegistry& registry) {
   r.description = "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true)";
   r.keys = hfo::sim_keys();
   r.keys.push_back(hfo::shoot_action_key());
+  // Subtracted from the reward when the ball goes out of bounds (hfo::ShapedReward); 0 keeps
+  // dqn-hfo's reward. In the reward's units: a goal is 5.
+  r.keys.push_back(EnvKey::integer("out_of_bounds_penalty", 0, 0, 100));
   r.make = [](const EnvParams& p) {
-    return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p), p.boolean("shoot_action"));
+    return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p), p.boolean("shoot_action"),
+                                         static_cast<int>(p.integer("out_of_bounds_penalty")));
   };
   r.observation_size = [](const EnvParams& p) { return hfo::HfoEnv(hfo::sim_config(p)).observation_size(); };
   r.gives_embedded_hfo_features = [](const EnvParams&) { return true; };
