@@ -174,7 +174,7 @@ TEST(HfoReferee, TouchResetsUntouchedCounter) {
 
 class HfoReward : public ::testing::Test {
  protected:
-  HfoReward() : env_(quiet_config()) {}
+  explicit HfoReward(int out_of_bounds_penalty = 0) : env_(quiet_config(), false, out_of_bounds_penalty) {}
 
   void start(const PlayerState& agent, const BallState& ball) { env_.set_state(agent, ball, obs_); }
 
@@ -334,19 +334,20 @@ TEST_F(HfoReward, OutOfBoundsPaysZero) {
 
 // env.out_of_bounds_penalty = 4: the same out-of-bounds episode pays -4 on its terminal step and
 // nothing else changes; a goal still pays exactly 5.
-TEST(HfoRewardPenalty, OutOfBoundsPaysMinusThePenalty) {
-  HfoEnv env(quiet_config(), false, 4);
-  std::array<float, 58> obs{};
-  std::array<float, param::kCount> params{};
-  const auto idle = [&] { return env.step(ParamAction{kTurn, params}, obs); };
-  env.set_state(make_agent({30.0, 5.0}), BallState{{1.0, 0.0}, {-2.0, 0.0}}, obs);
+class HfoRewardPenalty : public HfoReward {
+ protected:
+  HfoRewardPenalty() : HfoReward(4) {}
+};
+
+TEST_F(HfoRewardPenalty, OutOfBoundsPaysMinusThePenalty) {
+  start(make_agent({30.0, 5.0}), BallState{{1.0, 0.0}, {-2.0, 0.0}});
   StepResult r = idle();
   EXPECT_EQ(r.status, kInGame);
   EXPECT_EQ(r.reward, 0.0F);
   r = idle();
   EXPECT_EQ(r.status, kOutOfBounds);
   EXPECT_EQ(r.reward, -4.0F);
-  env.set_state(make_agent({40.0, 10.0}), BallState{{52.0, 0.0}, {1.0, 0.0}}, obs);
+  start(make_agent({40.0, 10.0}), BallState{{52.0, 0.0}, {1.0, 0.0}});
   r = idle();
   EXPECT_EQ(r.status, kGoal);
   EXPECT_EQ(r.reward, 5.0F);
