@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -32,9 +33,8 @@ const DdpgConfig& checked(const DdpgConfig& c, bool multipass) {
     throw std::invalid_argument("ddpg.demo_bc_weight: " + name +
                                 " does not clone demonstrations; set it to 0 (or train.algorithm = \"ddpg\")");
   }
-  if (c.actor_average_tau > 0.0) {
-    throw std::invalid_argument("ddpg.actor_average_tau: " + name +
-                                " keeps no evaluation average; set it to 0 (or train.algorithm = \"ddpg\")");
+  if (!(c.actor_average_tau >= 0.0 && c.actor_average_tau <= 1.0)) {
+    throw std::invalid_argument("ddpg.actor_average_tau must be in [0, 1]");
   }
   if (c.device == UpdateDevice::kCuda) {
     throw std::invalid_argument("ddpg.device = cuda: " + name +
@@ -65,6 +65,8 @@ constexpr const char* kParamTau = "pdqn.param_tau";
 constexpr const char* kRewardScale = "pdqn.reward_scale";
 constexpr const char* kPassthrough = "pdqn.passthrough";
 constexpr const char* kParamOutputInitStd = "pdqn.param_output_init_std";
+constexpr const char* kParamAverage = "param_average";
+constexpr const char* kQAverage = "q_average";
 
 }  // namespace
 
@@ -108,6 +110,8 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       target_param_(param_.widths(), config.batch_size),
       target_q_(q_.widths(), (multipass ? space.num_actions() : 1) * config.batch_size),
       passthrough_({obs_dim, space.num_params()}, config.batch_size),
+      param_average_(param_.widths(), 1),
+      q_average_(q_.widths(), multipass ? space.num_actions() : 1),
       param_adam_(param_.num_params(), adam(config, config.actor_learning_rate)),
       q_adam_(q_.num_params(), adam(config, config.critic_learning_rate)),
       forward_(obs_dim, space, multipass),
@@ -152,6 +156,35 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       passthrough_.bias(0)(p) = prior->bias[static_cast<size_t>(p)];
     }
   }
+  reset_average();
+}
+
+void Pdqn::reset_average() {
+  std::copy(param_.params().begin(), param_.params().end(), param_average_.params().begin());
+  std::copy(q_.params().begin(), q_.params().end(), q_average_.params().begin());
+  average_at_ = updates_;
+}
+
+void Pdqn::sync_acting() {
+  const int64_t k = updates_ - average_at_;
+  if (!averages() || k <= 0) {
+    return;
+  }
+  const double rate = -std::expm1(static_cast<double>(k) * std::log1p(-config_.actor_average_tau));
+  // average <- rate * online + (1 - rate) * average
+  soft_update<float>(param_average_.params(), param_.params(), rate);
+  soft_update<float>(q_average_.params(), q_.params(), rate);
+  average_at_ = updates_;
+}
+
+std::string Pdqn::evaluated_copy_note() const {
+  if (!averages()) {
+    return {};
+  }
+  std::ostringstream s;
+  s << "evaluations and best.ckpt play the average of the parameter and Q-networks (ddpg.actor_average_tau = "
+    << config_.actor_average_tau << ")";
+  return s.str();
 }
 
 void Pdqn::set_gates(std::vector<ActionGate> gates) {
@@ -172,9 +205,19 @@ void Pdqn::set_gates(std::vector<ActionGate> gates) {
 }
 
 void Pdqn::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
-  const bool target = copy == ActorCopy::kTarget;
-  forward_(target ? target_param_ : param_, target ? target_q_ : q_,
-           config_.bound == BoundMethod::kSquashing ? &param_bounds_ : nullptr, obs, out,
+  if (copy == ActorCopy::kAverage && !averages()) {
+    throw std::logic_error("P-DQN: no evaluation average is kept (ddpg.actor_average_tau = 0)");
+  }
+  Mlp<float>* param = &param_;
+  Mlp<float>* q = &q_;
+  if (copy == ActorCopy::kTarget) {
+    param = &target_param_;
+    q = &target_q_;
+  } else if (copy == ActorCopy::kAverage) {
+    param = &param_average_;
+    q = &q_average_;
+  }
+  forward_(*param, *q, config_.bound == BoundMethod::kSquashing ? &param_bounds_ : nullptr, obs, out,
            settings_.passthrough ? &passthrough_ : nullptr);
 }
 
@@ -422,18 +465,33 @@ std::vector<StateTensor> Pdqn::state_tensors() {
   if (settings_.passthrough) {
     t.push_back({"param_passthrough", passthrough_.params(), {}, false});
   }
+  if (averages()) {
+    t.push_back({kParamAverage, param_average_.params(), param_average_.widths(), true});
+    t.push_back({kQAverage, q_average_.params(), q_average_.widths(), true});
+  }
   return t;
 }
 
 std::vector<StateCounter> Pdqn::state_counters() {
-  counters_ = {updates_, param_adam_.steps(), q_adam_.steps()};
-  return {{"updates", &counters_[0]}, {"param_adam.steps", &counters_[1]}, {"q_adam.steps", &counters_[2]}};
+  counters_ = {updates_, param_adam_.steps(), q_adam_.steps(), average_at_};
+  std::vector<StateCounter> c = {
+      {"updates", &counters_[0]}, {"param_adam.steps", &counters_[1]}, {"q_adam.steps", &counters_[2]}};
+  if (averages()) {
+    c.push_back({"average_updates", &counters_[3]});
+  }
+  return c;
 }
 
-void Pdqn::restored(const std::vector<std::string>& /*missing*/) {
+void Pdqn::restored(const std::vector<std::string>& missing) {
   updates_ = counters_[0];
   param_adam_.set_steps(counters_[1]);
   q_adam_.set_steps(counters_[2]);
+  const auto lacks = [&](const char* n) { return std::find(missing.begin(), missing.end(), n) != missing.end(); };
+  if (lacks(kParamAverage) || lacks(kQAverage)) {
+    reset_average();  // written without one (ddpg.actor_average_tau was 0, or an older build)
+  } else {
+    average_at_ = counters_[3];
+  }
 }
 
 void register_pdqn_algorithms(AlgorithmRegistry& registry) {

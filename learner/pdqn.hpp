@@ -22,13 +22,15 @@
 // rates for the two networks, a reward scale, and MP-DQN's pass-through layer (PdqnSettings).
 // It reads the ddpg.* settings (hidden widths for both networks, learning rates: actor for the
 // parameter network, critic for the Q-network, Adam, γ, τ, batch, clipping, bound, Monte-Carlo
-// mix, learning-rate decay, initialisation). It neither clones demonstrations nor keeps an
-// evaluation average, and runs on the CPU: a config that asks for those is refused.
+// mix, learning-rate decay, initialisation, and ddpg.actor_average_tau: a Polyak average of both
+// networks the actors act with, which evaluations then play). It does not clone demonstrations,
+// and runs on the CPU: a config that asks for those is refused.
 //
 // State names: networks "param", "q", "target_param", "target_q"; Adam moments "param_adam.m",
 // "param_adam.v", "q_adam.m", "q_adam.v"; counters "updates", "param_adam.steps",
-// "q_adam.steps"; with the pass-through layer, "param_passthrough" too. The actors get "param"
-// and "q", and "param_passthrough" with the layer. update() allocates nothing.
+// "q_adam.steps"; with the pass-through layer, "param_passthrough" too; with an evaluation average,
+// the optional "param_average" and "q_average" and the counter "average_updates". The actors get
+// "param" and "q", and "param_passthrough" with the layer. update() allocates nothing.
 #pragma once
 
 #include <Eigen/Core>
@@ -87,15 +89,23 @@ class Pdqn final : public Algorithm {
   UpdateStats update(const BatchView& batch, const BatchView* demos = nullptr) override;
   UpdateStats finish() override { return last_; }
 
-  void sync_acting() override {}
+  // Moves the evaluation average (ddpg.actor_average_tau > 0) toward the online networks as far as
+  // the updates since the last call would have moved it one update at a time: by
+  // 1 - (1 - tau)^k, as Ddpg::track_actor_average does for its actor.
+  void sync_acting() override;
+  // kAverage plays the average of both networks (std::logic_error without one).
   void act(std::span<const float> obs, std::span<float> out, ActorCopy copy = ActorCopy::kOnline) override;
+  [[nodiscard]] ActorCopy evaluated_copy() const override {
+    return averages() ? ActorCopy::kAverage : ActorCopy::kOnline;
+  }
+  [[nodiscard]] std::string evaluated_copy_note() const override;
   ActingWeights acting_weights() override;
 
   void sync_to_host() override {}
   std::vector<StateTensor> state_tensors() override;
   std::vector<StateCounter> state_counters() override;
   void restored(const std::vector<std::string>& missing) override;
-  void warm_started() override {}
+  void warm_started() override { reset_average(); }  // this run's average starts at its start weights
 
   // The gradients of one update's two losses at the current weights, left in q_net().grads() and
   // param_net().grads() (the parameter loss through the current Q-network), with the losses'
@@ -114,6 +124,11 @@ class Pdqn final : public Algorithm {
   Mlp<float>& target_q_net() { return target_q_; }
   // The fixed pass-through layer (widths {obs, P}); all zeros without settings.passthrough.
   Mlp<float>& passthrough_net() { return passthrough_; }
+  // The evaluation average (kept when ddpg.actor_average_tau > 0), and the updates() it last absorbed.
+  [[nodiscard]] bool averages() const { return config_.actor_average_tau > 0.0; }
+  Mlp<float>& param_average() { return param_average_; }
+  Mlp<float>& q_average() { return q_average_; }
+  [[nodiscard]] int64_t average_updates() const { return average_at_; }
 
  private:
   // x(s) for the batch's states into x_ (and the raw outputs in the network).
@@ -143,6 +158,8 @@ class Pdqn final : public Algorithm {
   double q_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
   double param_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
   void schedule_learning_rates();
+  // Restarts the average at the online networks, as of updates_.
+  void reset_average();
 
   int obs_dim_;
   int num_actions_;
@@ -161,13 +178,16 @@ class Pdqn final : public Algorithm {
   Mlp<float> q_;
   Mlp<float> target_param_;
   Mlp<float> target_q_;
-  Mlp<float> passthrough_;  // shared by the parameter network and its target
+  Mlp<float> passthrough_;    // shared by the parameter network, its target and its average
+  Mlp<float> param_average_;  // followed only when averages()
+  Mlp<float> q_average_;
+  int64_t average_at_ = 0;
   Adam<float> param_adam_;
   Adam<float> q_adam_;
   int64_t updates_ = 0;
   UpdateStats last_;
   PdqnForward forward_;
-  std::array<int64_t, 3> counters_{};
+  std::array<int64_t, 4> counters_{};
 
   // Scratch, sized in the constructor for batch_size.
   Eigen::MatrixXf x_;       // P x B: parameters fed to the Q-network

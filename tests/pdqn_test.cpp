@@ -356,12 +356,9 @@ TEST(Pdqn, RefusesSettingsItDoesNotHave) {
   const ActionSpace space = test_space();
   DdpgConfig cloning = small(BoundMethod::kInverting);
   cloning.demo_bc_weight = 1.0;
-  DdpgConfig average = small(BoundMethod::kInverting);
-  average.actor_average_tau = 1e-3;
   DdpgConfig gpu = small(BoundMethod::kInverting);
   gpu.device = UpdateDevice::kCuda;
-  for (const auto& [config, key] : {std::pair{cloning, "ddpg.demo_bc_weight"},
-                                    std::pair{average, "ddpg.actor_average_tau"}, std::pair{gpu, "ddpg.device"}}) {
+  for (const auto& [config, key] : {std::pair{cloning, "ddpg.demo_bc_weight"}, std::pair{gpu, "ddpg.device"}}) {
     try {
       Pdqn p(kObs, space, config, 1, false);
       ADD_FAILURE() << key << " was accepted";
@@ -574,6 +571,132 @@ TEST(Pdqn, PassthroughIsCheckpointed) {
   EXPECT_TRUE(std::equal(saved.passthrough_net().params().begin(), saved.passthrough_net().params().end(),
                          loaded.passthrough_net().params().begin()));
   fs::remove_all(dir);
+}
+
+std::vector<float> flat(std::span<const float> a, std::span<const float> b) {
+  std::vector<float> v(a.begin(), a.end());
+  v.insert(v.end(), b.begin(), b.end());
+  return v;
+}
+
+// The evaluation average (ddpg.actor_average_tau): it starts as both online networks, absorbs
+// the updates since its last sync_acting() by 1 - (1 - tau)^k, stands still without new updates,
+// and act(kAverage) plays it, the pass-through layer included. Without it there is none to play.
+TEST(Pdqn, EvaluationAverageMovesByTheUpdatesSinceItsLastCall) {
+  for (const bool multipass : {false, true}) {
+    const ActionSpace space = test_space();
+    const ParameterPrior prior = random_prior(4);
+    DdpgConfig c = small(BoundMethod::kInverting);
+    c.actor_average_tau = 0.1;
+    Pdqn p(kObs, space, c, 3, multipass, {}, with_passthrough(0.5F), &prior);
+    EXPECT_EQ(p.evaluated_copy(), ActorCopy::kAverage);
+    EXPECT_NE(p.evaluated_copy_note().find("actor_average_tau"), std::string::npos);
+    const std::vector<float> start = flat(p.param_net().params(), p.q_net().params());
+    ASSERT_EQ(start, flat(p.param_average().params(), p.q_average().params()));
+    const Batch batch;
+    for (int i = 0; i < 3; ++i) {
+      p.update(batch.view());
+    }
+    const std::vector<float> online = flat(p.param_net().params(), p.q_net().params());
+    ASSERT_NE(online, start);
+    ASSERT_EQ(start, flat(p.param_average().params(), p.q_average().params()));  // not synced yet
+    p.sync_acting();
+    EXPECT_EQ(p.average_updates(), 3);
+    const std::vector<float> avg = flat(p.param_average().params(), p.q_average().params());
+    for (size_t i = 0; i < avg.size(); ++i) {
+      ASSERT_NEAR(avg[i], start[i] + 0.271F * (online[i] - start[i]), 1e-6F) << i;  // 1 - 0.9^3
+    }
+    p.sync_acting();  // nothing new to absorb
+    EXPECT_EQ(avg, flat(p.param_average().params(), p.q_average().params()));
+
+    // A learner whose online networks are that average acts as act(kAverage) does.
+    Pdqn copy(kObs, space, c, 4, multipass, {}, with_passthrough(0.5F), &prior);
+    std::copy(p.param_average().params().begin(), p.param_average().params().end(), copy.param_net().params().begin());
+    std::copy(p.q_average().params().begin(), p.q_average().params().end(), copy.q_net().params().begin());
+    std::vector<float> mine(6);
+    std::vector<float> theirs(6);
+    std::vector<float> online_out(6);
+    bool differs = false;
+    for (int i = 0; i < 10; ++i) {
+      const Eigen::Vector3f s = Eigen::Vector3f::Random();
+      p.act({s.data(), kObs}, mine, ActorCopy::kAverage);
+      copy.act({s.data(), kObs}, theirs);
+      p.act({s.data(), kObs}, online_out);
+      EXPECT_EQ(mine, theirs) << multipass;
+      differs = differs || mine != online_out;
+    }
+    EXPECT_TRUE(differs) << "act(kAverage) plays the online networks";
+
+    Pdqn plain(kObs, space, small(BoundMethod::kInverting), 3, multipass);
+    EXPECT_EQ(plain.evaluated_copy(), ActorCopy::kOnline);
+    EXPECT_TRUE(plain.evaluated_copy_note().empty());
+    EXPECT_THROW(plain.act({start.data(), kObs}, mine, ActorCopy::kAverage), std::logic_error);
+  }
+}
+
+// The average is in the checkpoint with the update it last absorbed; a checkpoint written without
+// one starts it at the loaded online networks, as a warm start does.
+TEST(Pdqn, EvaluationAverageIsCheckpointed) {
+  const ActionSpace space = test_space();
+  DdpgConfig c = small(BoundMethod::kInverting);
+  c.actor_average_tau = 0.1;
+  Pdqn saved(kObs, space, c, 5, true);
+  const Batch batch;
+  for (int i = 0; i < 4; ++i) {
+    saved.update(batch.view());
+    if (i == 1) {
+      saved.sync_acting();
+    }
+  }
+  const fs::path dir = fresh_dir("average");
+  fs::create_directories(dir);
+  const std::string path = (dir / "a.ckpt").string();
+  save_checkpoint(path, saved, {});
+  Pdqn loaded(kObs, space, c, 6, true);
+  load_checkpoint(path, loaded);
+  EXPECT_EQ(flat(saved.param_average().params(), saved.q_average().params()),
+            flat(loaded.param_average().params(), loaded.q_average().params()));
+  EXPECT_EQ(loaded.average_updates(), 2);
+  EXPECT_EQ(loaded.updates(), 4);
+
+  Pdqn without(kObs, space, small(BoundMethod::kInverting), 7, true);
+  without.update(batch.view());
+  save_checkpoint(path, without, {});
+  load_checkpoint(path, loaded);
+  EXPECT_EQ(flat(without.param_net().params(), without.q_net().params()),
+            flat(loaded.param_average().params(), loaded.q_average().params()));
+  EXPECT_EQ(loaded.average_updates(), 1);
+
+  save_checkpoint(path, saved, {});
+  Pdqn warm(kObs, space, c, 8, true);
+  warm_start_from_checkpoint(path, warm);
+  EXPECT_EQ(flat(saved.param_net().params(), saved.q_net().params()),
+            flat(warm.param_average().params(), warm.q_average().params()));
+  fs::remove_all(dir);
+}
+
+// Through `pamdp train`: a run with the average, stopped and resumed, ends with the same state
+// (the average included) as one that never stopped, and its average has moved off the start.
+TEST(Pdqn, EvaluationAverageSurvivesAResume) {
+  const auto config = [](int64_t updates) {
+    app::ExperimentConfig c = toy("mpdqn", updates);
+    c.ddpg.actor_average_tau = 1e-3;
+    return c;
+  };
+  const fs::path straight = fresh_dir("avg_straight");
+  const fs::path halves = fresh_dir("avg_halves");
+  app::train(config(3000), {straight.string(), false, true, nullptr});
+  app::train(config(1950), {halves.string(), false, true, nullptr});
+  app::train(config(3000), {halves.string(), true, true, nullptr});
+  EXPECT_EQ(state_of(straight / "checkpoint.ckpt", config(3000)), state_of(halves / "checkpoint.ckpt", config(3000)));
+  const toy::ReachStopEnv env;
+  const std::unique_ptr<Algorithm> a = app::make_learner(config(3000), env.observation_size(), env.action_space(), 99);
+  load_checkpoint((straight / "checkpoint.ckpt").string(), *a);
+  auto& p = dynamic_cast<Pdqn&>(*a);
+  EXPECT_EQ(p.average_updates(), p.updates());
+  EXPECT_NE(flat(p.param_average().params(), p.q_average().params()), flat(p.param_net().params(), p.q_net().params()));
+  fs::remove_all(straight);
+  fs::remove_all(halves);
 }
 
 }  // namespace
