@@ -3,6 +3,7 @@
 // construction. Not thread-safe. Spans must have matching sizes; a mismatch is a bug and aborts.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -63,6 +64,13 @@ double clip_global_norm(std::span<Scalar> grads, double max_norm);
 // only, so a mutable source span (online.params()) binds too.
 template <typename Scalar>
 void soft_update(std::span<Scalar> target, std::type_identity_t<std::span<const Scalar>> source, double tau);
+
+// The rate one soft_update must take to move as far as `steps` soft updates at `tau` would
+// with the source held still: 1 - (1 - tau)^steps (evaluation averages absorb several updates
+// at once).
+inline double soft_update_rate(double tau, int64_t steps) {
+  return -std::expm1(static_cast<double>(steps) * std::log1p(-tau));
+}
 
 extern template class Adam<float>;
 extern template class Adam<double>;

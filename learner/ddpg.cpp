@@ -91,7 +91,7 @@ void Ddpg::track_actor_average() {
   if (config_.actor_average_tau <= 0.0 || k <= 0) {
     return;
   }
-  const auto rate = static_cast<float>(-std::expm1(static_cast<double>(k) * std::log1p(-config_.actor_average_tau)));
+  const auto rate = static_cast<float>(soft_update_rate(config_.actor_average_tau, k));
   const auto online = actor_.params();
   const auto avg = actor_average_.params();
   for (size_t i = 0; i < avg.size(); ++i) {

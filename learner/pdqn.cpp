@@ -170,8 +170,7 @@ void Pdqn::sync_acting() {
   if (!averages() || k <= 0) {
     return;
   }
-  const double rate = -std::expm1(static_cast<double>(k) * std::log1p(-config_.actor_average_tau));
-  // average <- rate * online + (1 - rate) * average
+  const double rate = soft_update_rate(config_.actor_average_tau, k);
   soft_update<float>(param_average_.params(), param_.params(), rate);
   soft_update<float>(q_average_.params(), q_.params(), rate);
   average_at_ = updates_;
