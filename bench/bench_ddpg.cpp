@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "bench/update_bench.hpp"
@@ -68,13 +69,15 @@ void BM_PdqnUpdate(benchmark::State& state) {
     benchmark::DoNotOptimize(s.critic_loss);
   }
   state.SetItemsProcessed(state.iterations());
-  state.SetLabel(multipass ? "mpdqn" : "pdqn");
+  state.SetLabel(std::string(multipass ? "mpdqn " : "pdqn ") + pamdp::gemm_backend());
 }
 BENCHMARK(BM_PdqnUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // C = A * B for (m x k) * (k x n): the achievable single-core GEMM rate here, through the
-// update's own gemm() (eigen = false) or Eigen's product.
-void gemm_rate(benchmark::State& state, bool eigen) {
+// update's own gemm() (the library it chose, labelled), or on one library.
+enum class Through { kGemm, kEigen, kOpenBlas };
+
+void gemm_rate(benchmark::State& state, Through through) {
   const auto m = state.range(0);
   const auto k = state.range(1);
   const auto n = state.range(2);
@@ -82,19 +85,24 @@ void gemm_rate(benchmark::State& state, bool eigen) {
   const Eigen::MatrixXf B = Eigen::MatrixXf::Random(k, n);
   Eigen::MatrixXf C(m, n);
   for (auto _ : state) {
-    if (eigen) {
+    if (through == Through::kEigen) {
       C.noalias() = A * B;
+    } else if (through == Through::kOpenBlas) {
+      pamdp::gemm_on<float>(pamdp::GemmLibrary::kOpenBlas, pamdp::Op::kNone, A, pamdp::Op::kNone, B, C,
+                            /*accumulate=*/false);
     } else {
       pamdp::gemm<float>(pamdp::Op::kNone, A, pamdp::Op::kNone, B, C, /*accumulate=*/false);
     }
     benchmark::DoNotOptimize(C.data());
   }
   state.SetItemsProcessed(state.iterations() * 2 * m * k * n);
-  state.SetLabel(eigen ? "Eigen" : pamdp::gemm_backend());
+  state.SetLabel(through == Through::kEigen      ? "Eigen"
+                 : through == Through::kOpenBlas ? "OpenBLAS"
+                                                 : pamdp::gemm_backend());
 }
 
 void BM_GemmRoofline(benchmark::State& state) {
-  gemm_rate(state, false);
+  gemm_rate(state, Through::kGemm);
 }
 BENCHMARK(BM_GemmRoofline)
     ->Args({2048, 2048, 2048})
@@ -103,8 +111,19 @@ BENCHMARK(BM_GemmRoofline)
     ->Unit(benchmark::kMillisecond);
 
 void BM_GemmEigen(benchmark::State& state) {
-  gemm_rate(state, true);
+  gemm_rate(state, Through::kEigen);
 }
 BENCHMARK(BM_GemmEigen)->Args({2048, 2048, 2048})->Args({1024, 512, 32})->Unit(benchmark::kMillisecond);
+
+// OpenBLAS where it is built in, whichever library gemm() chose: on AVX-512 builds gemm()
+// runs on Eigen, and this row is what it would get from OpenBLAS in the same run.
+void BM_GemmOpenBlas(benchmark::State& state) {
+  if (!pamdp::gemm_library_available(pamdp::GemmLibrary::kOpenBlas)) {
+    state.SkipWithError("OpenBLAS is not built in");
+    return;
+  }
+  gemm_rate(state, Through::kOpenBlas);
+}
+BENCHMARK(BM_GemmOpenBlas)->Args({2048, 2048, 2048})->Args({1024, 512, 32})->Unit(benchmark::kMillisecond);
 
 }  // namespace

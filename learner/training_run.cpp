@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/files.hpp"
+#include "core/gemm.hpp"
 #include "core/log.hpp"
 #include "learner/greedy_policy.hpp"
 
@@ -87,6 +88,7 @@ CheckpointMeta TrainingRun::start(bool resume) {
   if (const std::string note = algorithm_.evaluated_copy_note(); !note.empty()) {
     log::info("{}: {}", spec_.role, note);
   }
+  log::info("{}: CPU matrix products on {} (PAMDP_GEMM=eigen|openblas overrides)", spec_.role, gemm_backend());
   std::optional<ResumePoint> resume_at;
   if (resume) {
     resume_at =

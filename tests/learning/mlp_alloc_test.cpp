@@ -154,7 +154,7 @@ long allocations_in_forward_backward(const std::vector<int>& widths, int batch) 
 // Every transpose combination and row counts with and without a tail past a multiple of 16
 // (OpenBLAS's AVX-512 kernels allocate on a * b for some tails; gemm routes those rows around).
 template <typename Scalar>
-long allocations_in_gemm(int m, int n, int k) {
+long allocations_in_gemm(GemmLibrary library, int m, int n, int k) {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   const Matrix a = Matrix::Random(std::max(m, k), std::max(m, k));
   const Matrix b = Matrix::Random(std::max(n, k), std::max(n, k));
@@ -164,8 +164,8 @@ long allocations_in_gemm(int m, int n, int k) {
     for (const Op op_b : {Op::kNone, Op::kTranspose}) {
       const auto lhs = op_a == Op::kNone ? a.topLeftCorner(m, k) : a.topLeftCorner(k, m);
       const auto rhs = op_b == Op::kNone ? b.topLeftCorner(k, n) : b.topLeftCorner(n, k);
-      gemm<Scalar>(op_a, lhs, op_b, rhs, c, /*accumulate=*/false);
-      gemm<Scalar>(op_a, lhs, op_b, rhs, c, /*accumulate=*/true);
+      gemm_on<Scalar>(library, op_a, lhs, op_b, rhs, c, /*accumulate=*/false);
+      gemm_on<Scalar>(library, op_a, lhs, op_b, rhs, c, /*accumulate=*/true);
     }
   }
   return scope.count();
@@ -175,10 +175,16 @@ TEST(GemmAllocations, EveryShapeOfTheMlpAllocatesNothing) {
   if (!kCounting) {
     GTEST_SKIP() << "AddressSanitizer owns malloc";
   }
-  for (int m : {1, 3, 8, 10, 16, 24, 70, 128}) {
-    for (int n : {1, 32}) {
-      EXPECT_EQ(allocations_in_gemm<float>(m, n, 128), 0) << "float " << m << "x" << n << "x128";
-      EXPECT_EQ(allocations_in_gemm<double>(m, n, 68), 0) << "double " << m << "x" << n << "x68";
+  for (const GemmLibrary library : {GemmLibrary::kEigen, GemmLibrary::kOpenBlas}) {
+    if (!gemm_library_available(library)) {
+      continue;
+    }
+    const char* name = library == GemmLibrary::kEigen ? "Eigen" : "OpenBLAS";
+    for (int m : {1, 3, 8, 10, 16, 24, 70, 128}) {
+      for (int n : {1, 32}) {
+        EXPECT_EQ(allocations_in_gemm<float>(library, m, n, 128), 0) << name << " float " << m << "x" << n << "x128";
+        EXPECT_EQ(allocations_in_gemm<double>(library, m, n, 68), 0) << name << " double " << m << "x" << n << "x68";
+      }
     }
   }
 }

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <span>
 #include <stdexcept>
 #include <type_traits>
@@ -515,7 +517,7 @@ TEST(Optim, SoftUpdate) {
 // accumulated, on blocks of larger matrices (leading dimension > rows), including a one-row
 // operand, a batch of one and a shape large enough for any library's blocked kernels.
 template <typename Scalar>
-void check_gemm(Op op_a, Op op_b, int m, int n, int k, bool accumulate) {
+void check_gemm(GemmLibrary library, Op op_a, Op op_b, int m, int n, int k, bool accumulate) {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   Rng rng(static_cast<uint64_t>(m * 131 + n * 17 + k));
   auto random = [&](int rows, int cols) {
@@ -533,7 +535,7 @@ void check_gemm(Op op_a, Op op_b, int m, int n, int k, bool accumulate) {
   const Matrix c_before = c_store;
   const auto a = a_store.topRows(ta ? k : m);
   const auto b = b_store.topRows(tb ? n : k);
-  gemm<Scalar>(op_a, a, op_b, b, c_store.topRows(m), accumulate);
+  gemm_on<Scalar>(library, op_a, a, op_b, b, c_store.topRows(m), accumulate);
   double worst = 0.0;
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < n; ++j) {
@@ -546,26 +548,65 @@ void check_gemm(Op op_a, Op op_b, int m, int n, int k, bool accumulate) {
   }
   // Float sums of up to 300 products of magnitude <= 1: rounding well under 1e-4.
   const double tolerance = std::is_same_v<Scalar, float> ? 1e-4 : 1e-12;
-  EXPECT_LT(worst, tolerance) << "op_a " << ta << " op_b " << tb << " " << m << "x" << n << "x" << k << " accumulate "
-                              << accumulate;
+  EXPECT_LT(worst, tolerance) << "library " << static_cast<int>(library) << " op_a " << ta << " op_b " << tb << " " << m
+                              << "x" << n << "x" << k << " accumulate " << accumulate;
   // Rows below the block are untouched.
   EXPECT_TRUE((c_store.bottomRows(5).array() == c_before.bottomRows(5).array()).all());
 }
 
 TEST(Gemm, AgreesWithALoopForEveryTransposeOnBlocks) {
-  for (const Op op_a : {Op::kNone, Op::kTranspose}) {
-    for (const Op op_b : {Op::kNone, Op::kTranspose}) {
-      for (const bool accumulate : {false, true}) {
-        check_gemm<float>(op_a, op_b, 70, 32, 300, accumulate);
-        check_gemm<float>(op_a, op_b, 1, 32, 64, accumulate);
-        check_gemm<float>(op_a, op_b, 10, 1, 5, accumulate);
-        check_gemm<float>(op_a, op_b, 16, 32, 64, accumulate);  // a whole row block, no tail
-        check_gemm<float>(op_a, op_b, 24, 32, 64, accumulate);  // a block and an 8-row tail
-        check_gemm<double>(op_a, op_b, 33, 7, 129, accumulate);
+  int libraries = 0;
+  for (const GemmLibrary library : {GemmLibrary::kEigen, GemmLibrary::kOpenBlas}) {
+    if (!gemm_library_available(library)) {
+      continue;
+    }
+    ++libraries;
+    for (const Op op_a : {Op::kNone, Op::kTranspose}) {
+      for (const Op op_b : {Op::kNone, Op::kTranspose}) {
+        for (const bool accumulate : {false, true}) {
+          check_gemm<float>(library, op_a, op_b, 70, 32, 300, accumulate);
+          check_gemm<float>(library, op_a, op_b, 1, 32, 64, accumulate);
+          check_gemm<float>(library, op_a, op_b, 10, 1, 5, accumulate);
+          check_gemm<float>(library, op_a, op_b, 16, 32, 64, accumulate);  // a whole row block, no tail
+          check_gemm<float>(library, op_a, op_b, 24, 32, 64, accumulate);  // a block and an 8-row tail
+          check_gemm<double>(library, op_a, op_b, 33, 7, 129, accumulate);
+        }
       }
     }
   }
+  EXPECT_GE(libraries, 1);
+  EXPECT_TRUE(gemm_library_available(GemmLibrary::kEigen));
   EXPECT_FALSE(gemm_backend().empty());
+}
+
+// PAMDP_GEMM picks the library at gemm()'s first call; each case runs in a fresh process
+// (threadsafe death tests re-execute the binary), so the choice is not already made.
+void expect_choice(const char* value, GemmLibrary want) {
+  setenv("PAMDP_GEMM", value, 1);
+  std::exit(gemm_library() == want ? 0 : 1);
+}
+
+TEST(GemmDeathTest, TheEnvironmentChoosesTheLibrary) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(expect_choice("eigen", GemmLibrary::kEigen), testing::ExitedWithCode(0), "");
+  EXPECT_EXIT(
+      {
+        setenv("PAMDP_GEMM", "eigen", 1);
+        std::fprintf(stderr, "%s\n", gemm_backend().c_str());
+        std::exit(0);
+      },
+      testing::ExitedWithCode(0), "^Eigen [0-9]");
+  if (gemm_library_available(GemmLibrary::kOpenBlas)) {
+    EXPECT_EXIT(expect_choice("openblas", GemmLibrary::kOpenBlas), testing::ExitedWithCode(0), "");
+  }
+  // A wrong value is named with the fix, and the build's default is kept.
+  EXPECT_EXIT(
+      {
+        setenv("PAMDP_GEMM", "mkl", 1);
+        std::exit(gemm_library_available(gemm_library()) ? 0 : 1);
+      },
+      testing::ExitedWithCode(0),
+      "PAMDP_GEMM=mkl is not a library of this build; using (Eigen|OpenBLAS).*Set it to eigen");
 }
 
 TEST(GemmDeathTest, ShapesThatDoNotAgreeAbort) {
