@@ -555,12 +555,10 @@ void check_gemm(GemmLibrary library, Op op_a, Op op_b, int m, int n, int k, bool
 }
 
 TEST(Gemm, AgreesWithALoopForEveryTransposeOnBlocks) {
-  int libraries = 0;
   for (const GemmLibrary library : {GemmLibrary::kEigen, GemmLibrary::kOpenBlas}) {
     if (!gemm_library_available(library)) {
       continue;
     }
-    ++libraries;
     for (const Op op_a : {Op::kNone, Op::kTranspose}) {
       for (const Op op_b : {Op::kNone, Op::kTranspose}) {
         for (const bool accumulate : {false, true}) {
@@ -574,8 +572,7 @@ TEST(Gemm, AgreesWithALoopForEveryTransposeOnBlocks) {
       }
     }
   }
-  EXPECT_GE(libraries, 1);
-  EXPECT_TRUE(gemm_library_available(GemmLibrary::kEigen));
+  EXPECT_TRUE(gemm_library_available(GemmLibrary::kEigen));  // so the loop checked at least one
   EXPECT_FALSE(gemm_backend().empty());
 }
 
