@@ -1,5 +1,6 @@
 #include "actor/acting_policy.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace pamdp {
@@ -29,6 +30,13 @@ std::string ActingPolicyRegistry::names() const {
     s += (s.empty() ? "" : ", ") + r.name;
   }
   return s;
+}
+
+void load_network(const NetworkView& n, std::unique_ptr<Mlp<float>>& net, int batch) {
+  if (net == nullptr || !std::equal(n.widths.begin(), n.widths.end(), net->widths().begin(), net->widths().end())) {
+    net = std::make_unique<Mlp<float>>(std::vector<int>(n.widths.begin(), n.widths.end()), batch);
+  }
+  std::copy(n.params.begin(), n.params.end(), net->params().begin());
 }
 
 const ActingPolicyRegistry& acting_policy_registry() {

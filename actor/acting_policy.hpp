@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/action_space.hpp"
+#include "core/mlp.hpp"
 #include "core/network_view.hpp"
 
 namespace pamdp {
@@ -55,5 +56,10 @@ class ActingPolicyRegistry {
 };
 
 const ActingPolicyRegistry& acting_policy_registry();
+
+// Copies the parameters of `n` into `net`, which it makes anew (for batches of `batch` columns)
+// only when there is none or its widths differ: on the first weights, or after a learner restart
+// with other widths, not per message.
+void load_network(const NetworkView& n, std::unique_ptr<Mlp<float>>& net, int batch);
 
 }  // namespace pamdp

@@ -1,6 +1,7 @@
-// DDPG's acting policy: the actor network "actor", its output squashed into the parameter bounds
-// when the learner bounds by squashing (bound 2), as the learner's own act() does
-// (core/actor_output.hpp).
+// DDPG's acting policy: the actor network "actor", plus the fixed pass-through layer
+// "actor_passthrough" on its parameter outputs when the learner has one (ddpg.passthrough), the
+// output squashed into the parameter bounds when the learner bounds by squashing (bound 2), as
+// the learner's own act() does (core/actor_output.hpp).
 #include <Eigen/Core>
 #include <algorithm>
 #include <memory>
@@ -20,11 +21,22 @@ constexpr uint8_t kMaxBound = 2;
 class DdpgActingPolicy final : public ActingPolicy {
  public:
   DdpgActingPolicy(int obs_dim, const ActionSpace& space)
-      : obs_dim_(obs_dim), width_(space.output_width()), bounds_(OutputBounds::for_actor(space)), input_(obs_dim, 1) {}
+      : obs_dim_(obs_dim),
+        width_(space.output_width()),
+        num_params_(space.num_params()),
+        bounds_(OutputBounds::for_actor(space)),
+        input_(obs_dim, 1) {}
 
   [[nodiscard]] const char* check(std::span<const NetworkView> networks, uint8_t bound) const override {
-    if (networks.size() != 1 || networks[0].name != "actor") {
-      return "DDPG weights carry one network, \"actor\"";
+    if (networks.empty() || networks.size() > 2 || networks[0].name != "actor" ||
+        (networks.size() == 2 && networks[1].name != "actor_passthrough")) {
+      return "DDPG weights carry the network \"actor\", and optionally \"actor_passthrough\"";
+    }
+    if (networks.size() == 2) {
+      const std::span<const int> t = networks[1].widths;
+      if (t.size() != 2 || t.front() != obs_dim_ || t.back() != num_params_ || num_params_ < 1) {
+        return "the DDPG pass-through layer's widths do not fit this env's observation and parameter widths";
+      }
     }
     const std::span<const int> w = networks[0].widths;
     if (w.front() != obs_dim_ || w.back() != width_) {
@@ -34,28 +46,31 @@ class DdpgActingPolicy final : public ActingPolicy {
   }
 
   void load(std::span<const NetworkView> networks, uint8_t bound) override {
-    const NetworkView& n = networks[0];
-    if (net_ == nullptr ||
-        !std::equal(n.widths.begin(), n.widths.end(), net_->widths().begin(), net_->widths().end())) {
-      // Only on the first weights (or a learner restarted with other hidden widths): not per step.
-      net_ = std::make_unique<Mlp<float>>(std::vector<int>(n.widths.begin(), n.widths.end()), 1);
+    load_network(networks[0], net_, 1);
+    if (networks.size() == 2) {
+      load_network(networks[1], passthrough_, 1);
+    } else {
+      passthrough_.reset();
     }
-    std::copy(n.params.begin(), n.params.end(), net_->params().begin());
     squash_ = bound == kBoundSquashing;
   }
 
   void act(std::span<const float> obs, std::span<float> out) override {
-    actor_output(*net_, input_, obs, squash_ ? &bounds_ : nullptr, out);
+    actor_output(*net_, input_, obs, squash_ ? &bounds_ : nullptr, out, passthrough_.get());
   }
 
-  [[nodiscard]] int64_t num_params() const override { return net_ != nullptr ? net_->num_params() : 0; }
+  [[nodiscard]] int64_t num_params() const override {
+    return (net_ != nullptr ? net_->num_params() : 0) + (passthrough_ != nullptr ? passthrough_->num_params() : 0);
+  }
 
  private:
   int obs_dim_;
   int width_;
+  int num_params_;
   OutputBounds bounds_;
   Eigen::MatrixXf input_;
   std::unique_ptr<Mlp<float>> net_;
+  std::unique_ptr<Mlp<float>> passthrough_;
   bool squash_ = false;
 };
 

@@ -46,10 +46,10 @@ class PdqnActingPolicy final : public ActingPolicy {
   }
 
   void load(std::span<const NetworkView> networks, uint8_t bound) override {
-    take(networks[0], param_, 1);
-    take(networks[1], q_, forward_.passes());
+    load_network(networks[0], param_, 1);
+    load_network(networks[1], q_, forward_.passes());
     if (networks.size() == 3) {
-      take(networks[2], passthrough_, 1);
+      load_network(networks[2], passthrough_, 1);
     } else {
       passthrough_.reset();
     }
@@ -66,13 +66,6 @@ class PdqnActingPolicy final : public ActingPolicy {
   }
 
  private:
-  static void take(const NetworkView& n, std::unique_ptr<Mlp<float>>& net, int batch) {
-    if (net == nullptr || !std::equal(n.widths.begin(), n.widths.end(), net->widths().begin(), net->widths().end())) {
-      net = std::make_unique<Mlp<float>>(std::vector<int>(n.widths.begin(), n.widths.end()), batch);
-    }
-    std::copy(n.params.begin(), n.params.end(), net->params().begin());
-  }
-
   int obs_dim_;
   int num_actions_;
   int num_params_;

@@ -82,6 +82,9 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("ddpg.demo_bc_weight", c.ddpg.demo_bc_weight, 0.0, 1e6);
   v.boolean("ddpg.demo_q_filter", c.ddpg.demo_q_filter);
   v.real("ddpg.actor_average_tau", c.ddpg.actor_average_tau, 0.0, 1.0);
+  v.boolean("ddpg.passthrough", c.ddpg.passthrough);
+  v.real("ddpg.actor_output_init_std", c.ddpg.actor_output_init_std, 0.0, 10.0);
+  v.real("ddpg.reward_scale", c.ddpg.reward_scale, 1e-9, 1e9);
   // Each algorithm's own keys, as its registration declares them (learner/algorithm.hpp).
   for (const AlgorithmKey& k : algorithm_registry().keys()) {
     AlgorithmValue& value = c.algorithm_params.at(k.name);

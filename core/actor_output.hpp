@@ -18,18 +18,26 @@
 namespace pamdp {
 
 // `input` is the caller's obs_dim x 1 scratch column; `squash_into` is null unless the
-// policy squashes. `out` has the network's output width.
+// policy squashes; `passthrough`, when given, is a fixed layer {obs_dim, P} added to the last P
+// outputs (the parameters) before a squash (core/passthrough.hpp). `out` has the network's
+// output width.
 inline void actor_output(Mlp<float>& net, Eigen::MatrixXf& input, std::span<const float> obs,
-                         const OutputBounds* squash_into, std::span<float> out) {
+                         const OutputBounds* squash_into, std::span<float> out, Mlp<float>* passthrough = nullptr) {
   assert(input.cols() == 1 && static_cast<size_t>(input.rows()) == obs.size());
   input.col(0) = Eigen::Map<const Eigen::VectorXf>(obs.data(), input.rows());
   const auto raw = net.forward(input);
-  const std::span<const float> raw_span(raw.data(), static_cast<size_t>(raw.rows()));
-  assert(out.size() == raw_span.size());
+  assert(out.size() == static_cast<size_t>(raw.rows()));
+  std::copy(raw.data(), raw.data() + raw.rows(), out.begin());
+  if (passthrough != nullptr) {
+    const auto extra = passthrough->forward(input);
+    assert(static_cast<size_t>(extra.rows()) <= out.size());
+    const size_t first = out.size() - static_cast<size_t>(extra.rows());
+    for (Eigen::Index p = 0; p < extra.rows(); ++p) {
+      out[first + static_cast<size_t>(p)] += extra(p, 0);
+    }
+  }
   if (squash_into != nullptr) {
-    squash(raw_span, *squash_into, out);
-  } else {
-    std::copy(raw_span.begin(), raw_span.end(), out.begin());
+    squash(out, *squash_into, out);  // element by element, so in place is safe
   }
 }
 

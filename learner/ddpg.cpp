@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/actor_output.hpp"
+#include "core/passthrough.hpp"
 
 namespace pamdp {
 namespace {
@@ -28,7 +29,7 @@ int actor_batch(const DdpgConfig& c) {
 
 }  // namespace
 
-Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed)
+Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, const ParameterPrior* prior)
     : obs_dim_(obs_dim),
       config_(config),
       bounds_(OutputBounds::for_actor(space)),
@@ -37,6 +38,7 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       target_actor_(actor_.widths(), config.batch_size),
       target_critic_(critic_.widths(), config.batch_size),
       actor_average_(actor_.widths(), 1),
+      passthrough_({obs_dim, space.num_params()}, actor_batch(config)),
       actor_adam_(actor_.num_params(), adam(config, config.actor_learning_rate)),
       critic_adam_(critic_.num_params(), adam(config, config.critic_learning_rate)),
       critic_in_(obs_dim + space.output_width(), actor_batch(config)),
@@ -53,6 +55,9 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   }
   if (!(config.actor_average_tau >= 0.0 && config.actor_average_tau <= 1.0)) {
     throw std::invalid_argument("ddpg.actor_average_tau must be in [0, 1]");
+  }
+  if (!(config.reward_scale > 0.0)) {
+    throw std::invalid_argument("ddpg.reward_scale must be > 0");
   }
   num_actions_ = space.num_actions();
   if (config.demo_bc_weight > 0.0) {
@@ -72,9 +77,17 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   }
   Rng rng(seed);
   const auto s = static_cast<float>(config.init_std);
-  actor_.init_gaussian(rng, s);
+  actor_.init_gaussian(rng, s, static_cast<float>(config.actor_output_init_std));
   critic_.init_gaussian(rng, s, static_cast<float>(config.critic_output_init_std),
                         static_cast<float>(config.critic_output_init_bias));
+  std::fill(passthrough_.params().begin(), passthrough_.params().end(), 0.0F);
+  if (config.passthrough) {
+    if (space.num_params() < 1) {
+      throw std::invalid_argument("ddpg.passthrough: this env's actions have no continuous parameters");
+    }
+    load_passthrough(passthrough_, prior, "ddpg.passthrough");
+    pre_.resize(space.output_width(), actor_batch(config));
+  }
   // Targets start as exact copies (reference §7.2).
   std::copy(actor_.params().begin(), actor_.params().end(), target_actor_.params().begin());
   std::copy(critic_.params().begin(), critic_.params().end(), target_critic_.params().begin());
@@ -103,6 +116,20 @@ void Ddpg::track_actor_average() {
 void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int batch,
                          Eigen::MatrixXf& out) {
   const auto raw = net.forward(states.leftCols(batch));
+  if (config_.passthrough) {
+    const int P = passthrough_.output_width();
+    pre_.leftCols(batch) = raw;
+    pre_.bottomLeftCorner(P, batch) += passthrough_.forward(states.leftCols(batch));
+    if (config_.bound == BoundMethod::kSquashing) {
+      for (int j = 0; j < batch; ++j) {
+        squash({pre_.col(j).data(), static_cast<size_t>(pre_.rows())}, bounds_,
+               {out.col(j).data(), static_cast<size_t>(out.rows())});
+      }
+    } else {
+      out.leftCols(batch) = pre_.leftCols(batch);
+    }
+    return;
+  }
   if (config_.bound == BoundMethod::kSquashing) {
     for (int j = 0; j < batch; ++j) {
       squash({raw.col(j).data(), static_cast<size_t>(raw.rows())}, bounds_,
@@ -116,7 +143,8 @@ void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf
 void Ddpg::act(std::span<const float> obs, std::span<float> out, ActorCopy copy) {
   assert(static_cast<int>(obs.size()) == obs_dim_ && static_cast<int>(out.size()) == output_width());
   Mlp<float>& net = copy == ActorCopy::kTarget ? target_actor_ : copy == ActorCopy::kAverage ? actor_average_ : actor_;
-  actor_output(net, single_in_, obs, config_.bound == BoundMethod::kSquashing ? &bounds_ : nullptr, out);
+  actor_output(net, single_in_, obs, config_.bound == BoundMethod::kSquashing ? &bounds_ : nullptr, out,
+               config_.passthrough ? &passthrough_ : nullptr);
 }
 
 void Ddpg::schedule_learning_rates() {
@@ -144,11 +172,12 @@ UpdateStats Ddpg::update(const BatchView& batch, const BatchView* demos) {
   const auto g = static_cast<float>(config_.gamma);
   const auto beta = static_cast<float>(config_.mc_mix);
   const auto clip = static_cast<float>(config_.bootstrap_clip);
+  const auto scale = static_cast<float>(config_.reward_scale);
   for (int j = 0; j < B; ++j) {
     const float next = clip > 0.0F ? std::clamp(q_next(0, j), -clip, clip) : q_next(0, j);
-    float y = batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * next);
+    float y = scale * batch.rewards(j) + (batch.terminal(j) > 0.5F ? 0.0F : g * next);
     if (beta > 0.0F) {
-      y = beta * batch.mc_returns(j) + (1.0F - beta) * y;
+      y = beta * scale * batch.mc_returns(j) + (1.0F - beta) * y;
     }
     targets_(0, j) = y;
   }
@@ -248,7 +277,11 @@ UpdateStats Ddpg::update(const BatchView& batch, const BatchView* demos) {
     critic_.backward_input(d_q_.leftCols(B));  // only dQ/da: critic parameter gradients are not needed
     d_action_.leftCols(B) = critic_.input_grad().bottomRows(W);
   }
-  apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N), actor_.output(), d_action_.leftCols(N));
+  if (config_.passthrough) {
+    apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N), pre_.leftCols(N), d_action_.leftCols(N));
+  } else {
+    apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N), actor_.output(), d_action_.leftCols(N));
+  }
   actor_.backward(d_action_.leftCols(N), false);
   stats.actor_grad_norm = static_cast<float>(clip_global_norm(actor_.grads(), config_.clip_grad_norm));
   actor_adam_.step(actor_.params(), actor_.grads());

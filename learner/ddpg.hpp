@@ -65,11 +65,24 @@ struct DdpgConfig {
   // quality swings by several points between evaluations; its average over a long window plays
   // steadier (Polyak & Juditsky 1992; for deep RL, Nikishin et al. 2018). 0 disables.
   double actor_average_tau = 0.0;
+  // MP-DQN's PA-DDPG (cycraig/MP-DQN agents/paddpg.py) adds a fixed pass-through layer, the env's
+  // hand-made parameter policy, to the actor's parameter outputs (core/passthrough.hpp): the
+  // parameters start at that policy and the actor learns corrections to it. Needs an env with a
+  // parameter_prior (envs/registry.hpp). CPU only.
+  bool passthrough = false;
+  // The actor's output layer's initial weight scale; 0: init_std (MP-DQN starts its hidden layers
+  // at Kaiming's scale and its output layers at 0.01).
+  double actor_output_init_std = 0.0;
+  // Rewards (and Monte-Carlo returns) are multiplied by this in the critic's target (MP-DQN's
+  // Goal runs scale by 1/50). CPU only when it is not 1.
+  double reward_scale = 1.0;
 };
 
 class Ddpg {
  public:
-  Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed);
+  // `prior` is read when config.passthrough (std::invalid_argument when it is null or does not fit).
+  Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed,
+       const ParameterPrior* prior = nullptr);
 
   // The actor's output for one observation, as actors execute and store it (after the squash
   // when the method is squashing). Writes output_width() values.
@@ -110,6 +123,9 @@ class Ddpg {
   Mlp<float>& target_critic() { return target_critic_; }
   Adam<float>& actor_optimizer() { return actor_adam_; }
   Adam<float>& critic_optimizer() { return critic_adam_; }
+  // The fixed pass-through layer (widths {obs, P}), shared by the actor, its target and its
+  // average; all zeros and unused without config.passthrough.
+  Mlp<float>& passthrough() { return passthrough_; }
 
  private:
   void actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int batch, Eigen::MatrixXf& out);
@@ -122,6 +138,7 @@ class Ddpg {
   Mlp<float> target_actor_;
   Mlp<float> target_critic_;
   Mlp<float> actor_average_;
+  Mlp<float> passthrough_;
   int64_t actor_average_at_ = 0;
   Adam<float> actor_adam_;
   Adam<float> critic_adam_;
@@ -132,6 +149,7 @@ class Ddpg {
   // actor step runs the batch and the demonstrations as one).
   Eigen::MatrixXf critic_in_;            // (obs + width) x B
   Eigen::MatrixXf actions_;              // width x B (executed/squashed outputs)
+  Eigen::MatrixXf pre_;                  // width x B: actor(s) + passthrough(s), before a squash
   Eigen::MatrixXf targets_;              // 1 x B
   Eigen::MatrixXf d_q_;                  // 1 x B
   Eigen::MatrixXf d_action_;             // width x B

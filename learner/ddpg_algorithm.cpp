@@ -8,12 +8,13 @@ namespace pamdp {
 namespace {
 
 constexpr const char* kAverage = "actor_average";
+constexpr const char* kPassthrough = "actor_passthrough";
 
 }  // namespace
 
 DdpgAlgorithm::DdpgAlgorithm(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed,
-                             UpdateDevice device)
-    : ddpg_(obs_dim, space, config, seed), backend_(make_update_backend(ddpg_, device)) {}
+                             UpdateDevice device, const ParameterPrior* prior)
+    : ddpg_(obs_dim, space, config, seed, prior), backend_(make_update_backend(ddpg_, device)) {}
 
 UpdateStats DdpgAlgorithm::update(const BatchView& batch, const BatchView* demos) {
   return demos != nullptr ? backend_->update(batch, *demos) : backend_->update(batch);
@@ -35,7 +36,11 @@ std::string DdpgAlgorithm::evaluated_copy_note() const {
 
 ActingWeights DdpgAlgorithm::acting_weights() {
   const Mlp<float>& actor = ddpg_.actor();
-  return {name(), static_cast<uint8_t>(ddpg_.config().bound), {{"actor", actor.widths(), actor.params()}}};
+  ActingWeights w{name(), static_cast<uint8_t>(ddpg_.config().bound), {{"actor", actor.widths(), actor.params()}}};
+  if (ddpg_.config().passthrough) {
+    w.networks.push_back({kPassthrough, ddpg_.passthrough().widths(), ddpg_.passthrough().params()});
+  }
+  return w;
 }
 
 std::vector<StateTensor> DdpgAlgorithm::state_tensors() {
@@ -51,6 +56,9 @@ std::vector<StateTensor> DdpgAlgorithm::state_tensors() {
   net("target_critic", ddpg_.target_critic());
   adam("actor_adam", ddpg_.actor_optimizer());
   adam("critic_adam", ddpg_.critic_optimizer());
+  if (ddpg_.config().passthrough) {
+    t.push_back({kPassthrough, ddpg_.passthrough().params(), {}, false});
+  }
   if (ddpg_.averages_actor()) {
     t.push_back({kAverage, ddpg_.actor_average().params(), ddpg_.actor_average().widths(), true});
   }
@@ -95,7 +103,7 @@ void register_ddpg_algorithm(AlgorithmRegistry& registry) {
                         "and a gate would take an action they do not rank first; gate actions with "
                         "train.algorithm = \"pdqn\" or \"mpdqn\", or leave exploration.gated_actions empty");
                   }
-                  return std::make_unique<DdpgAlgorithm>(a.obs_dim, *a.space, *a.ddpg, a.seed, a.device);
+                  return std::make_unique<DdpgAlgorithm>(a.obs_dim, *a.space, *a.ddpg, a.seed, a.device, a.prior);
                 },
                 {}});  // no keys beyond ddpg.*
 }

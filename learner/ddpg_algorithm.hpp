@@ -4,9 +4,11 @@
 //
 // Its state, by name: the networks "actor", "critic", "target_actor", "target_critic"; the Adam
 // moments "actor_adam.m", "actor_adam.v", "critic_adam.m", "critic_adam.v"; with an actor
-// average, "actor_average" (optional: a checkpoint without one restarts it). Counters:
+// average, "actor_average" (optional: a checkpoint without one restarts it); with the
+// pass-through layer (ddpg.passthrough), "actor_passthrough". Counters:
 // "updates", "actor_adam.steps", "critic_adam.steps", "actor_average_updates". The actors get
-// one network, "actor", and the bound (they squash its output under the squashing bound).
+// the network "actor", "actor_passthrough" with the layer, and the bound (they squash the output
+// under the squashing bound).
 #pragma once
 
 #include <array>
@@ -20,7 +22,8 @@ namespace pamdp {
 
 class DdpgAlgorithm final : public Algorithm {
  public:
-  DdpgAlgorithm(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, UpdateDevice device);
+  DdpgAlgorithm(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint64_t seed, UpdateDevice device,
+                const ParameterPrior* prior = nullptr);
 
   [[nodiscard]] std::string_view name() const override { return "ddpg"; }
   [[nodiscard]] int obs_dim() const override { return ddpg_.obs_dim(); }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/passthrough.hpp"
 #include "learner/gradient_bounds.hpp"
 
 namespace pamdp {
@@ -36,28 +37,26 @@ const DdpgConfig& checked(const DdpgConfig& c, bool multipass) {
   if (!(c.actor_average_tau >= 0.0 && c.actor_average_tau <= 1.0)) {
     throw std::invalid_argument("ddpg.actor_average_tau must be in [0, 1]");
   }
+  // PA-DDPG's own forms of P-DQN's keys: these learners read pdqn.passthrough,
+  // pdqn.param_output_init_std and pdqn.reward_scale instead.
+  if (c.passthrough) {
+    throw std::invalid_argument("ddpg.passthrough is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
+                                " takes pdqn.passthrough: set that instead, and ddpg.passthrough = false");
+  }
+  if (c.actor_output_init_std != 0.0) {
+    throw std::invalid_argument(
+        "ddpg.actor_output_init_std is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
+        " takes pdqn.param_output_init_std: set that instead, and ddpg.actor_output_init_std = 0");
+  }
+  if (c.reward_scale != 1.0) {
+    throw std::invalid_argument("ddpg.reward_scale is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
+                                " takes pdqn.reward_scale: set that instead, and ddpg.reward_scale = 1");
+  }
   if (c.device == UpdateDevice::kCuda) {
     throw std::invalid_argument("ddpg.device = cuda: " + name +
                                 " updates on the CPU only; set ddpg.device = \"cpu\" or \"auto\"");
   }
   return c;
-}
-
-const PdqnSettings& checked(const PdqnSettings& s, const ParameterPrior* prior, int obs_dim, int num_params) {
-  if (s.passthrough) {
-    if (prior == nullptr) {
-      throw std::invalid_argument(
-          "pdqn.passthrough = true starts the parameters from the env's hand-made parameter policy, and this env has "
-          "none (envs/registry.hpp, parameter_prior); set pdqn.passthrough = false");
-    }
-    if (prior->obs_dim != obs_dim || prior->bias.size() != static_cast<size_t>(num_params) ||
-        prior->weights.size() != static_cast<size_t>(obs_dim) * static_cast<size_t>(num_params)) {
-      throw std::invalid_argument(
-          "pdqn.passthrough: the env's parameter policy does not fit its observation and "
-          "parameter widths");
-    }
-  }
-  return s;
 }
 
 constexpr const char* kQTau = "pdqn.q_tau";
@@ -100,7 +99,7 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       num_params_(space.num_params()),
       multipass_(multipass),
       config_(checked(config, multipass)),
-      settings_(checked(settings, prior, obs_dim, space.num_params())),
+      settings_(settings),
       param_bounds_(parameter_bounds(space)),
       masked_(static_cast<size_t>(space.num_actions()), false),
       owner_(static_cast<size_t>(space.num_params()), 0),
@@ -149,12 +148,7 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   std::copy(q_.params().begin(), q_.params().end(), target_q_.params().begin());
   std::fill(passthrough_.params().begin(), passthrough_.params().end(), 0.0F);
   if (settings_.passthrough) {
-    for (int p = 0; p < num_params_; ++p) {
-      for (int j = 0; j < obs_dim_; ++j) {
-        passthrough_.weight(0)(p, j) = prior->weights[static_cast<size_t>(p * obs_dim_ + j)];
-      }
-      passthrough_.bias(0)(p) = prior->bias[static_cast<size_t>(p)];
-    }
+    load_passthrough(passthrough_, prior, kPassthrough);
   }
   reset_average();
 }

@@ -26,14 +26,20 @@ std::unique_ptr<UpdateBackend> make_update_backend(Ddpg& ddpg, UpdateDevice devi
   if (device == UpdateDevice::kCpu) {
     return std::make_unique<CpuUpdateBackend>(ddpg);
   }
-  if (ddpg.config().demo_bc_weight > 0.0) {
-    // The CUDA update has no cloning term (learner/ddpg.hpp).
+  // Settings the CUDA update does not have (learner/ddpg.hpp): the cloning term, the pass-through
+  // layer and a reward scale.
+  const DdpgConfig& c = ddpg.config();
+  const char* cpu_only = c.demo_bc_weight > 0.0  ? "ddpg.demo_bc_weight > 0"
+                         : c.passthrough         ? "ddpg.passthrough = true"
+                         : c.reward_scale != 1.0 ? "ddpg.reward_scale != 1"
+                                                 : nullptr;
+  if (cpu_only != nullptr) {
     if (device == UpdateDevice::kCuda) {
-      throw std::runtime_error(
-          "ddpg.device = \"cuda\" cannot clone demonstrations (ddpg.demo_bc_weight > 0 runs on the CPU only); use "
-          "ddpg.device = \"cpu\" or \"auto\", or set ddpg.demo_bc_weight = 0");
+      throw std::runtime_error(std::string("ddpg.device = \"cuda\": ") + cpu_only +
+                               " runs on the CPU only; use ddpg.device = \"cpu\" or \"auto\", or leave that setting "
+                               "at its default");
     }
-    log::info("learner: ddpg.device = auto: ddpg.demo_bc_weight > 0 runs on the CPU; updates run on the CPU");
+    log::info("learner: ddpg.device = auto: {} runs on the CPU; updates run on the CPU", cpu_only);
     return std::make_unique<CpuUpdateBackend>(ddpg);
   }
   std::string why;
