@@ -18,67 +18,26 @@
 #include "learner/ddpg_algorithm.hpp"
 #include "learner/pdqn.hpp"
 #include "learner/update_backend.hpp"
+#include "three_actions.hpp"
 
 namespace pamdp {
 namespace {
 
-// Three actions: one with one parameter, one with two, one with none (6 outputs: 3 scores, 3
-// parameters).
-ActionSpace test_space(float bound = 1.0F) {
-  ActionSpace s;
-  s.actions = {{"one", {0}}, {"two", {1, 2}}, {"none", {}}};
-  s.params = {{"p0", -bound, bound}, {"p1", -2.0F * bound, 2.0F * bound}, {"p2", 0.0F, bound}};
-  return s;
-}
+using testing::Batch;
+using testing::kB;
+using testing::kObs;
+using testing::random_prior;
+using testing::test_space;
 
-constexpr int kObs = 3;
-constexpr int kB = 5;
 constexpr int kWidth = 6;
 
-ParameterPrior random_prior(uint64_t seed) {
-  Rng rng(seed);
-  ParameterPrior p{kObs, std::vector<float>(3 * kObs), std::vector<float>(3)};
-  for (float& w : p.weights) {
-    w = static_cast<float>(rng.uniform(-1.0, 1.0));
-  }
-  for (float& b : p.bias) {
-    b = static_cast<float>(rng.uniform(-0.5, 0.5));
-  }
-  return p;
-}
-
+// testing::small with the layer and no gradient clipping.
 DdpgConfig small(BoundMethod bound) {
-  DdpgConfig c;
-  c.hidden = {6};
-  c.batch_size = kB;
-  c.bound = bound;
-  c.gamma = 0.9;
-  c.init_std = 0.5;
-  c.critic_output_init_std = 0.5;
-  c.critic_output_init_bias = 0.0;
+  DdpgConfig c = testing::small(bound);
   c.clip_grad_norm = 0.0;
-  c.device = UpdateDevice::kCpu;
   c.passthrough = true;
   return c;
 }
-
-struct Batch {
-  Eigen::MatrixXf states = Eigen::MatrixXf::Random(kObs, kB);
-  Eigen::MatrixXf actions = Eigen::MatrixXf::Random(kWidth, kB);
-  Eigen::VectorXf rewards = Eigen::VectorXf::Random(kB);
-  Eigen::MatrixXf next_states = Eigen::MatrixXf::Random(kObs, kB);
-  Eigen::VectorXf terminal = Eigen::VectorXf::Zero(kB);
-  Eigen::VectorXf mc = Eigen::VectorXf::Zero(kB);
-  Batch() { terminal(1) = 1.0F; }
-  [[nodiscard]] BatchView view() const {
-    return {Eigen::Map<const Eigen::MatrixXf>(states.data(), kObs, kB),
-            Eigen::Map<const Eigen::MatrixXf>(actions.data(), kWidth, kB),
-            Eigen::Map<const Eigen::VectorXf>(rewards.data(), kB),
-            Eigen::Map<const Eigen::MatrixXf>(next_states.data(), kObs, kB),
-            Eigen::Map<const Eigen::VectorXf>(terminal.data(), kB),
-            Eigen::Map<const Eigen::VectorXf>(mc.data(), kB)};
-  }
-};
 
 std::vector<float> copy_of(std::span<const float> s) {
   return {s.begin(), s.end()};
@@ -148,8 +107,11 @@ TEST(DdpgPassthrough, StartsAtThePriorStaysFixedAndTheActorsPlayIt) {
 // gradient in the actor's parameters (left in actor().grads() by the update) against central
 // differences of that loss through act(), which adds the layer and squashes as the actors do.
 TEST(DdpgPassthrough, ActorGradientMatchesFiniteDifferences) {
-  ActionSpace space = test_space(10.0F);  // zeroing: the identity while no output is at a bound
-  space.params[2].lo = -10.0F;
+  ActionSpace space = test_space();  // zeroing: the identity while no output is at a bound
+  for (ParamSpec& p : space.params) {
+    p.lo = -10.0F;
+    p.hi = 10.0F;
+  }
   const ParameterPrior prior = random_prior(8);
   for (const BoundMethod bound : {BoundMethod::kZeroing, BoundMethod::kSquashing}) {
     DdpgConfig c = small(bound);
