@@ -115,21 +115,14 @@ void Ddpg::track_actor_average() {
 
 void Ddpg::actor_outputs(Mlp<float>& net, const Eigen::Ref<const Eigen::MatrixXf>& states, int batch,
                          Eigen::MatrixXf& out) {
-  const auto raw = net.forward(states.leftCols(batch));
+  const auto net_out = net.forward(states.leftCols(batch));
   if (config_.passthrough) {
-    const int P = passthrough_.output_width();
-    pre_.leftCols(batch) = raw;
-    pre_.bottomLeftCorner(P, batch) += passthrough_.forward(states.leftCols(batch));
-    if (config_.bound == BoundMethod::kSquashing) {
-      for (int j = 0; j < batch; ++j) {
-        squash({pre_.col(j).data(), static_cast<size_t>(pre_.rows())}, bounds_,
-               {out.col(j).data(), static_cast<size_t>(out.rows())});
-      }
-    } else {
-      out.leftCols(batch) = pre_.leftCols(batch);
-    }
-    return;
+    pre_.leftCols(batch) = net_out;
+    pre_.bottomLeftCorner(passthrough_.output_width(), batch) += passthrough_.forward(states.leftCols(batch));
   }
+  const Eigen::Ref<const Eigen::MatrixXf> raw = config_.passthrough
+                                                    ? Eigen::Ref<const Eigen::MatrixXf>(pre_.leftCols(batch))
+                                                    : Eigen::Ref<const Eigen::MatrixXf>(net_out);
   if (config_.bound == BoundMethod::kSquashing) {
     for (int j = 0; j < batch; ++j) {
       squash({raw.col(j).data(), static_cast<size_t>(raw.rows())}, bounds_,
@@ -277,11 +270,11 @@ UpdateStats Ddpg::update(const BatchView& batch, const BatchView* demos) {
     critic_.backward_input(d_q_.leftCols(B));  // only dQ/da: critic parameter gradients are not needed
     d_action_.leftCols(B) = critic_.input_grad().bottomRows(W);
   }
-  if (config_.passthrough) {
-    apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N), pre_.leftCols(N), d_action_.leftCols(N));
-  } else {
-    apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N), actor_.output(), d_action_.leftCols(N));
-  }
+  // The bound reads the outputs before a squash: the actor's own, plus the layer when there is one.
+  apply_gradient_bounds(config_.bound, bounds_, actions_.leftCols(N),
+                        config_.passthrough ? Eigen::Ref<const Eigen::MatrixXf>(pre_.leftCols(N))
+                                            : Eigen::Ref<const Eigen::MatrixXf>(actor_.output()),
+                        d_action_.leftCols(N));
   actor_.backward(d_action_.leftCols(N), false);
   stats.actor_grad_norm = static_cast<float>(clip_global_norm(actor_.grads(), config_.clip_grad_norm));
   actor_adam_.step(actor_.params(), actor_.grads());

@@ -263,29 +263,45 @@ TEST(PdqnAllocations, UpdateAndActAllocateNothing) {
   }
 }
 
+// DDPG: update() and act() allocate nothing, with and without cloning, and with the pass-through
+// layer (ddpg.passthrough) under each bound, which reads its outputs before a squash.
 TEST(DdpgAllocations, UpdateAllocatesNothing) {
   if (!kCounting) {
     GTEST_SKIP() << "AddressSanitizer owns malloc";
   }
   const ActionSpace& space = hfo::hfo_action_space();
-  for (const double bc : {0.0, 1.0}) {
-    DdpgConfig c;
-    c.hidden = {256, 128, 64};
-    c.mc_mix = 0.5;
-    c.demo_bc_weight = bc;
-    Ddpg d(bench::RandomHfoBatch::kObs, space, c, 3);
-    const bench::RandomHfoBatch data(c.batch_size, 4);
-    const BatchView batch = data.view();
-    d.update(batch, &batch);  // first-call work (none expected) out of the count
-    long allocations = 0;
-    {
-      CountAllocations scope;
-      for (int i = 0; i < 3; ++i) {
-        d.update(batch, &batch);
+  const int obs = bench::RandomHfoBatch::kObs;
+  const ParameterPrior prior{obs, std::vector<float>(static_cast<size_t>(obs * space.num_params()), 0.01F),
+                             std::vector<float>(static_cast<size_t>(space.num_params()), 0.5F)};
+  for (const bool passthrough : {false, true}) {
+    for (const BoundMethod bound : {BoundMethod::kInverting, BoundMethod::kSquashing}) {
+      for (const double bc : {0.0, 1.0}) {
+        DdpgConfig c;
+        c.hidden = {256, 128, 64};
+        c.mc_mix = 0.5;
+        c.demo_bc_weight = bc;
+        c.bound = bound;
+        c.passthrough = passthrough;
+        c.reward_scale = passthrough ? 0.02 : 1.0;
+        Ddpg d(obs, space, c, 3, &prior);
+        const bench::RandomHfoBatch data(c.batch_size, 4);
+        const BatchView batch = data.view();
+        std::vector<float> out(static_cast<size_t>(d.output_width()));
+        d.update(batch, &batch);  // first-call work (none expected) out of the count
+        d.act({batch.states.data(), static_cast<size_t>(obs)}, out);
+        long allocations = 0;
+        {
+          CountAllocations scope;
+          for (int i = 0; i < 3; ++i) {
+            d.update(batch, &batch);
+            d.act({batch.states.data(), static_cast<size_t>(obs)}, out);
+          }
+          allocations = scope.count();
+        }
+        EXPECT_EQ(allocations, 0) << "demo_bc_weight " << bc << ", bound " << static_cast<int>(bound)
+                                  << (passthrough ? ", with the pass-through layer" : "");
       }
-      allocations = scope.count();
     }
-    EXPECT_EQ(allocations, 0) << "demo_bc_weight " << bc;
   }
 }
 
