@@ -38,7 +38,8 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
       target_actor_(actor_.widths(), config.batch_size),
       target_critic_(critic_.widths(), config.batch_size),
       actor_average_(actor_.widths(), 1),
-      passthrough_({obs_dim, space.num_params()}, actor_batch(config)),
+      // One row at least, so that an env without parameters still builds its (unused) layer.
+      passthrough_({obs_dim, std::max(space.num_params(), 1)}, actor_batch(config)),
       actor_adam_(actor_.num_params(), adam(config, config.actor_learning_rate)),
       critic_adam_(critic_.num_params(), adam(config, config.critic_learning_rate)),
       critic_in_(obs_dim + space.output_width(), actor_batch(config)),
@@ -80,8 +81,7 @@ Ddpg::Ddpg(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
   actor_.init_gaussian(rng, s, static_cast<float>(config.actor_output_init_std));
   critic_.init_gaussian(rng, s, static_cast<float>(config.critic_output_init_std),
                         static_cast<float>(config.critic_output_init_bias));
-  std::fill(passthrough_.params().begin(), passthrough_.params().end(), 0.0F);
-  if (config.passthrough) {
+  if (config.passthrough) {  // else the layer keeps the zeros it was made with
     if (space.num_params() < 1) {
       throw std::invalid_argument("ddpg.passthrough: this env's actions have no continuous parameters");
     }

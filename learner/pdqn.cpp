@@ -37,21 +37,16 @@ const DdpgConfig& checked(const DdpgConfig& c, bool multipass) {
   if (!(c.actor_average_tau >= 0.0 && c.actor_average_tau <= 1.0)) {
     throw std::invalid_argument("ddpg.actor_average_tau must be in [0, 1]");
   }
-  // PA-DDPG's own forms of P-DQN's keys: these learners read pdqn.passthrough,
-  // pdqn.param_output_init_std and pdqn.reward_scale instead.
-  if (c.passthrough) {
-    throw std::invalid_argument("ddpg.passthrough is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
-                                " takes pdqn.passthrough: set that instead, and ddpg.passthrough = false");
-  }
-  if (c.actor_output_init_std != 0.0) {
-    throw std::invalid_argument(
-        "ddpg.actor_output_init_std is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
-        " takes pdqn.param_output_init_std: set that instead, and ddpg.actor_output_init_std = 0");
-  }
-  if (c.reward_scale != 1.0) {
-    throw std::invalid_argument("ddpg.reward_scale is PA-DDPG's (train.algorithm = \"ddpg\"); " + name +
-                                " takes pdqn.reward_scale: set that instead, and ddpg.reward_scale = 1");
-  }
+  // PA-DDPG's own forms of P-DQN's keys: these learners read pdqn.* instead.
+  const auto not_here = [&](bool set, const std::string& key, const std::string& theirs, const char* unset) {
+    if (set) {
+      throw std::invalid_argument(key + " is PA-DDPG's (train.algorithm = \"ddpg\"); " + name + " takes " + theirs +
+                                  ": set that instead, and " + key + " = " + unset);
+    }
+  };
+  not_here(c.passthrough, "ddpg.passthrough", "pdqn.passthrough", "false");
+  not_here(c.actor_output_init_std != 0.0, "ddpg.actor_output_init_std", "pdqn.param_output_init_std", "0");
+  not_here(c.reward_scale != 1.0, "ddpg.reward_scale", "pdqn.reward_scale", "1");
   if (c.device == UpdateDevice::kCuda) {
     throw std::invalid_argument("ddpg.device = cuda: " + name +
                                 " updates on the CPU only; set ddpg.device = \"cpu\" or \"auto\"");
@@ -146,8 +141,7 @@ Pdqn::Pdqn(int obs_dim, const ActionSpace& space, const DdpgConfig& config, uint
                    static_cast<float>(config.critic_output_init_bias));
   std::copy(param_.params().begin(), param_.params().end(), target_param_.params().begin());
   std::copy(q_.params().begin(), q_.params().end(), target_q_.params().begin());
-  std::fill(passthrough_.params().begin(), passthrough_.params().end(), 0.0F);
-  if (settings_.passthrough) {
+  if (settings_.passthrough) {  // else the layer keeps the zeros it was made with
     load_passthrough(passthrough_, prior, kPassthrough);
   }
   reset_average();

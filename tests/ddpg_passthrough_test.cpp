@@ -196,6 +196,12 @@ TEST(DdpgPassthrough, MisuseIsRefusedNamingTheKey) {
   zero.passthrough = false;
   zero.reward_scale = 0.0;
   refused([&] { Ddpg d(kObs, space, zero, 1); }, "ddpg.reward_scale");
+  // An env whose actions have no parameters still trains without the layer, and is refused with it.
+  ActionSpace bare;
+  bare.actions = {{"left", {}}, {"right", {}}};
+  Ddpg plain(kObs, bare, testing::small(BoundMethod::kInverting), 1);
+  EXPECT_EQ(plain.output_width(), 2);
+  refused([&] { Ddpg d(kObs, bare, small(BoundMethod::kInverting), 1, &narrow); }, "no continuous parameters");
   // The CUDA update has neither setting.
   const ParameterPrior prior = random_prior(2);
   Ddpg d(kObs, space, small(BoundMethod::kInverting), 1, &prior);
