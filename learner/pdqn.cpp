@@ -59,6 +59,8 @@ constexpr const char* kParamTau = "pdqn.param_tau";
 constexpr const char* kRewardScale = "pdqn.reward_scale";
 constexpr const char* kPassthrough = "pdqn.passthrough";
 constexpr const char* kParamOutputInitStd = "pdqn.param_output_init_std";
+constexpr const char* kIndexedLoss = "pdqn.indexed_loss";
+constexpr const char* kZeroIndexGradients = "pdqn.zero_index_gradients";
 constexpr const char* kParamAverage = "param_average";
 constexpr const char* kQAverage = "q_average";
 
@@ -74,6 +76,10 @@ std::vector<AlgorithmKey> pdqn_keys() {
                             "add the env's hand-made parameter policy to the parameter network as a fixed layer"),
       AlgorithmKey::real(kParamOutputInitStd, 0.0, 0.0, 10.0,
                          "the parameter network's output-layer initial weight scale; 0: ddpg.init_std"),
+      AlgorithmKey::boolean(kIndexedLoss, false,
+                            "the parameter loss takes each sample's taken action alone, not the sum over actions"),
+      AlgorithmKey::boolean(kZeroIndexGradients, false,
+                            "the parameter step moves only the taken action's parameters of each sample"),
   };
 }
 
@@ -84,6 +90,8 @@ PdqnSettings PdqnSettings::from(const AlgorithmParams& params) {
   s.reward_scale = params.real(kRewardScale);
   s.passthrough = params.boolean(kPassthrough);
   s.param_output_init_std = params.real(kParamOutputInitStd);
+  s.indexed_loss = params.boolean(kIndexedLoss);
+  s.zero_index_gradients = params.boolean(kZeroIndexGradients);
   return s;
 }
 
@@ -348,7 +356,7 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
   const float per_sample = -1.0F / static_cast<float>(B);
   for (int j = 0; j < B; ++j) {
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)] && open(k, batch.states, j)) {
+      if (in_param_loss(k, batch.states, j)) {
         loss -= q_of(q, k, j, B);
         d_q_(k, multipass_ ? pass_[static_cast<size_t>(k)] * B + j : j) = per_sample;
       }
@@ -368,6 +376,15 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
     apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), pre_.leftCols(B), d_x_.leftCols(B));
   } else {
     apply_gradient_bounds(config_.bound, param_bounds_, x_.leftCols(B), param_.output(), d_x_.leftCols(B));
+  }
+  if (settings_.zero_index_gradients) {
+    for (int j = 0; j < B; ++j) {
+      for (int p = 0; p < num_params_; ++p) {
+        if (owner_[static_cast<size_t>(p)] != taken_[static_cast<size_t>(j)]) {
+          d_x_(p, j) = 0.0F;
+        }
+      }
+    }
   }
   param_.backward(d_x_.leftCols(B), false);
   return loss / B;
@@ -398,7 +415,7 @@ Pdqn::Losses Pdqn::losses(const BatchView& batch) {
   const auto qx = q_.forward(q_in_.leftCols(cols));
   for (int j = 0; j < B; ++j) {
     for (int k = 0; k < num_actions_; ++k) {
-      if (!masked_[static_cast<size_t>(k)] && open(k, batch.states, j)) {
+      if (in_param_loss(k, batch.states, j)) {
         l.param_loss -= static_cast<double>(q_of(qx, k, j, B)) / B;
       }
     }

@@ -16,7 +16,9 @@
 //      action k's, the others zero);
 //   3. parameter step on L = -(1 / B) Σ_batch Σ_k Q(s, k, x(s)) over the unmasked k, through the
 //      updated Q-network (its parameter gradients discarded), the gradient on x kept in bounds by
-//      ddpg.bound (inverting by default, as cycraig/MP-DQN; squashing squashes x);
+//      ddpg.bound (inverting by default, as cycraig/MP-DQN; squashing squashes x); with
+//      pdqn.indexed_loss over the taken k alone, with pdqn.zero_index_gradients only the taken
+//      action's parameters stepped;
 //   4. soft target updates at rate ddpg.tau (pdqn.q_tau, pdqn.param_tau when set).
 // Its own keys (declared at registration, the [pdqn] section, shared by both): separate target
 // rates for the two networks, a reward scale, and MP-DQN's pass-through layer (PdqnSettings).
@@ -59,6 +61,14 @@ struct PdqnSettings {
   // (param_output_init_std), so that x(s) starts at the hand-made policy.
   bool passthrough = false;
   double param_output_init_std = 0.0;  // the parameter network's output-layer weights; 0: ddpg.init_std
+  // Two options of MP-DQN's code (cycraig/MP-DQN agents/pdqn.py, `indexed` and
+  // `zero_index_gradients`; its run scripts leave both off). indexed_loss: the parameter loss takes
+  // only each sample's taken action, L = -(1 / B) Σ_j Q(s_j, a_j, x(s_j)), instead of the sum over
+  // the actions. zero_index_gradients: the gradient on x(s_j) keeps only the taken action's own
+  // parameters (the others' are zeroed after the bound), so action k's parameters learn only from
+  // samples that took k.
+  bool indexed_loss = false;
+  bool zero_index_gradients = false;
 
   static PdqnSettings from(const AlgorithmParams& params);
 };
@@ -150,6 +160,14 @@ class Pdqn final : public Algorithm {
       }
     }
     return true;
+  }
+  // Whether Q(s_j, k, x(s_j)) is in the parameter loss: k unmasked and open, and with
+  // pdqn.indexed_loss the action sample j took (targets() sets taken_).
+  [[nodiscard]] bool in_param_loss(int k, const Eigen::Ref<const Eigen::MatrixXf>& states, int j) const {
+    if (settings_.indexed_loss) {
+      return k == taken_[static_cast<size_t>(j)];
+    }
+    return !masked_[static_cast<size_t>(k)] && open(k, states, j);
   }
   [[nodiscard]] float q_of(const Mlp<float>::ConstBlock& q, int k, int j, int B) const {
     return multipass_ ? q(k, pass_[static_cast<size_t>(k)] * B + j) : q(k, j);

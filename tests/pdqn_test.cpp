@@ -1,5 +1,6 @@
 // P-DQN and MP-DQN (learner/pdqn.hpp): finite-difference checks of both losses' gradients,
-// hand-computed losses (the taken action, the masked max, MP-DQN's one-action passes), the
+// hand-computed losses (the taken action, the masked max, MP-DQN's one-action passes, the indexed
+// loss), the zeroed gradients of the actions not taken, the
 // actors' acting policy against the learner's own act(), and the toy task learned end to end
 // through `pamdp train`, resumed bit for bit.
 #include "learner/pdqn.hpp"
@@ -7,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -139,6 +141,117 @@ TEST(Pdqn, LossesByHand) {
     const Pdqn::Losses l = pdqn.losses(v);
     EXPECT_NEAR(l.q_loss, q_loss, 1e-5 * (1.0 + q_loss)) << (multipass ? "mpdqn" : "pdqn");
     EXPECT_NEAR(l.param_loss, param_loss, 1e-5 * (1.0 + std::abs(param_loss))) << (multipass ? "mpdqn" : "pdqn");
+  }
+}
+
+// pdqn.indexed_loss: the parameter loss takes each sample's taken action alone (the arg-max of
+// its stored scores over the unmasked actions), by hand from the learner's own act(), and its
+// gradient against finite differences.
+TEST(Pdqn, IndexedLossByHandAndFiniteDifferences) {
+  for (const bool multipass : {false, true}) {
+    ActionSpace space = test_space();
+    for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
+      p.lo = -10.0F;
+      p.hi = 10.0F;
+    }
+    PdqnSettings settings;
+    settings.indexed_loss = true;
+    Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, multipass, /*masked_actions=*/{1}, settings);
+    Batch b;
+    b.actions.col(0) << 0.2F, 0.9F, 0.1F, 0.5F, -0.5F, 0.25F;  // "two" scores highest but is masked
+    const BatchView v = b.view();
+    double param_loss = 0.0;
+    std::vector<float> out(6);
+    int took_two = 0;
+    for (int j = 0; j < kB; ++j) {
+      const int taken = b.actions(0, j) >= b.actions(2, j) ? 0 : 2;
+      took_two += taken == 2 ? 1 : 0;
+      pdqn.act({b.states.col(j).data(), kObs}, out, ActorCopy::kOnline);
+      param_loss -= out[static_cast<size_t>(taken)] / kB;
+    }
+    ASSERT_GT(took_two, 0);
+    ASSERT_LT(took_two, kB);
+    const Pdqn::Losses l = pdqn.losses(v);
+    EXPECT_NEAR(l.param_loss, param_loss, 1e-5 * (1.0 + std::abs(param_loss))) << (multipass ? "mpdqn" : "pdqn");
+    pdqn.gradients(v);
+    expect_gradients(
+        pdqn.param_net(), [&] { return pdqn.losses(v).param_loss; }, "indexed parameter loss");
+  }
+}
+
+// The gradient left on the parameter network's output row p (its weights and bias).
+std::vector<float> output_row_grads(Mlp<float>& net, int p) {
+  const int last = static_cast<int>(net.widths().size()) - 2;
+  auto w = net.weight(last);
+  auto bias = net.bias(last);
+  const auto at = [&](const float* x) { return net.grads()[static_cast<size_t>(x - net.params().data())]; };
+  std::vector<float> g;
+  for (int h = 0; h < w.cols(); ++h) {
+    g.push_back(at(&w(p, h)));
+  }
+  g.push_back(at(&bias(p)));
+  return g;
+}
+
+// pdqn.zero_index_gradients: on a batch whose samples all took one action, the parameter step
+// leaves the gradient of that action's own parameters as it was (the loss's own, by finite
+// differences) and zeroes every other parameter's; the loss itself is unchanged.
+TEST(Pdqn, ZeroIndexGradientsKeepOnlyTheTakenActionsParameters) {
+  for (const bool multipass : {false, true}) {
+    ActionSpace space = test_space();
+    for (ParamSpec& p : space.params) {
+      p.lo = -10.0F;
+      p.hi = 10.0F;
+    }
+    PdqnSettings zeroed;
+    zeroed.zero_index_gradients = true;
+    for (const int taken : {0, 1, 2}) {  // "one" owns p0, "two" p1 and p2, "none" nothing
+      Pdqn full(kObs, space, small(BoundMethod::kZeroing), 5, multipass);
+      Pdqn zero(kObs, space, small(BoundMethod::kZeroing), 5, multipass, {}, zeroed);
+      Batch b;
+      b.actions.row(taken).setConstant(2.0F);
+      const BatchView v = b.view();
+      EXPECT_DOUBLE_EQ(full.losses(v).param_loss, zero.losses(v).param_loss);
+      full.gradients(v);
+      zero.gradients(v);
+      const auto& owned = space.actions[static_cast<size_t>(taken)].param_indices;
+      for (int p = 0; p < 3; ++p) {
+        const bool own = std::find(owned.begin(), owned.end(), p) != owned.end();
+        const std::vector<float> f = output_row_grads(full.param_net(), p);
+        const std::vector<float> z = output_row_grads(zero.param_net(), p);
+        float largest = 0.0F;
+        for (size_t i = 0; i < f.size(); ++i) {
+          largest = std::max(largest, std::abs(f[i]));
+          EXPECT_FLOAT_EQ(z[i], own ? f[i] : 0.0F) << "action " << taken << ", parameter " << p << ", entry " << i;
+        }
+        EXPECT_GT(largest, 1e-4F) << "parameter " << p << " has no gradient to keep or zero";
+      }
+      if (owned.empty()) {
+        for (const float g : zero.param_net().grads()) {
+          ASSERT_EQ(g, 0.0F) << "a sample whose action has no parameters moves none";
+        }
+      }
+    }
+    // The rows kept are the loss's own gradient: finite differences of the full loss.
+    Pdqn zero(kObs, space, small(BoundMethod::kZeroing), 5, multipass, {}, zeroed);
+    Batch b;
+    b.actions.row(1).setConstant(2.0F);
+    const BatchView v = b.view();
+    zero.gradients(v);
+    Mlp<float>& net = zero.param_net();
+    const int last = static_cast<int>(net.widths().size()) - 2;
+    auto w = net.weight(last);
+    const std::vector<float> g = output_row_grads(net, 2);
+    for (int h = 0; h < w.cols(); ++h) {
+      const float keep = w(2, h);
+      w(2, h) = keep + 1e-3F;
+      const double up = zero.losses(v).param_loss;
+      w(2, h) = keep - 1e-3F;
+      const double down = zero.losses(v).param_loss;
+      w(2, h) = keep;
+      const double fd = (up - down) / 2e-3;
+      EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd)) << "p2's weight " << h;
+    }
   }
 }
 
