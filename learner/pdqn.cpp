@@ -61,6 +61,7 @@ constexpr const char* kPassthrough = "pdqn.passthrough";
 constexpr const char* kParamOutputInitStd = "pdqn.param_output_init_std";
 constexpr const char* kIndexedLoss = "pdqn.indexed_loss";
 constexpr const char* kZeroIndexGradients = "pdqn.zero_index_gradients";
+constexpr const char* kOwnActionGradients = "pdqn.own_action_gradients";
 constexpr const char* kParamAverage = "param_average";
 constexpr const char* kQAverage = "q_average";
 
@@ -80,6 +81,8 @@ std::vector<AlgorithmKey> pdqn_keys() {
                             "the parameter loss takes each sample's taken action alone, not the sum over actions"),
       AlgorithmKey::boolean(kZeroIndexGradients, false,
                             "the parameter step moves only the taken action's parameters of each sample"),
+      AlgorithmKey::boolean(kOwnActionGradients, false,
+                            "P-DQN: each action's parameters step on that action's own Q alone (MP-DQN has it already)"),
   };
 }
 
@@ -92,6 +95,7 @@ PdqnSettings PdqnSettings::from(const AlgorithmParams& params) {
   s.param_output_init_std = params.real(kParamOutputInitStd);
   s.indexed_loss = params.boolean(kIndexedLoss);
   s.zero_index_gradients = params.boolean(kZeroIndexGradients);
+  s.own_action_gradients = params.boolean(kOwnActionGradients);
   return s;
 }
 
@@ -362,14 +366,18 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
       }
     }
   }
-  q_.backward_input(d_q_.leftCols(cols));  // only dL/dx: the Q-network's parameter gradients are not needed
-  const auto in_grad = q_.input_grad();
-  for (int j = 0; j < B; ++j) {
-    for (int p = 0; p < num_params_; ++p) {
-      // In a multi-pass batch x_p reaches Q only through the pass of the action that owns it (a
-      // masked action has none: its parameters get no gradient, as its Q is not in the loss).
-      const int pass = multipass_ ? pass_[static_cast<size_t>(owner_[static_cast<size_t>(p)])] : 0;
-      d_x_(p, j) = pass < 0 ? 0.0F : in_grad(obs_dim_ + p, pass * B + j);
+  if (settings_.own_action_gradients && !multipass_) {
+    own_action_gradients(batch.states, B, per_sample);
+  } else {
+    q_.backward_input(d_q_.leftCols(cols));  // only dL/dx: the Q-network's parameter gradients are not needed
+    const auto in_grad = q_.input_grad();
+    for (int j = 0; j < B; ++j) {
+      for (int p = 0; p < num_params_; ++p) {
+        // In a multi-pass batch x_p reaches Q only through the pass of the action that owns it (a
+        // masked action has none: its parameters get no gradient, as its Q is not in the loss).
+        const int pass = multipass_ ? pass_[static_cast<size_t>(owner_[static_cast<size_t>(p)])] : 0;
+        d_x_(p, j) = pass < 0 ? 0.0F : in_grad(obs_dim_ + p, pass * B + j);
+      }
     }
   }
   if (settings_.passthrough) {
@@ -388,6 +396,34 @@ double Pdqn::param_step_gradient(const BatchView& batch, int B, UpdateStats& sta
   }
   param_.backward(d_x_.leftCols(B), false);
   return loss / B;
+}
+
+void Pdqn::own_action_gradients(const Eigen::Ref<const Eigen::MatrixXf>& states, int B, float per_sample) {
+  d_x_.leftCols(B).setZero();  // a parameter no action owns gets none
+  for (int k = 0; k < num_actions_; ++k) {
+    const std::vector<int>& owned = owned_[static_cast<size_t>(k)];
+    if (owned.empty()) {
+      continue;
+    }
+    d_q_.leftCols(B).setZero();
+    bool any = false;
+    for (int j = 0; j < B; ++j) {
+      if (in_param_loss(k, states, j)) {
+        d_q_(k, j) = per_sample;
+        any = true;
+      }
+    }
+    if (!any) {
+      continue;
+    }
+    q_.backward_input(d_q_.leftCols(B));  // the forward of param_step_gradient is still in place
+    const auto in_grad = q_.input_grad();
+    for (int j = 0; j < B; ++j) {
+      for (const int p : owned) {
+        d_x_(p, j) = in_grad(obs_dim_ + p, j);
+      }
+    }
+  }
 }
 
 Pdqn::Losses Pdqn::gradients(const BatchView& batch) {

@@ -18,7 +18,8 @@
 //      updated Q-network (its parameter gradients discarded), the gradient on x kept in bounds by
 //      ddpg.bound (inverting by default, as cycraig/MP-DQN; squashing squashes x); with
 //      pdqn.indexed_loss over the taken k alone, with pdqn.zero_index_gradients only the taken
-//      action's parameters stepped;
+//      action's parameters stepped, with pdqn.own_action_gradients each action's parameters on
+//      its own Q alone;
 //   4. soft target updates at rate ddpg.tau (pdqn.q_tau, pdqn.param_tau when set).
 // Its own keys (declared at registration, the [pdqn] section, shared by both): separate target
 // rates for the two networks, a reward scale, and MP-DQN's pass-through layer (PdqnSettings).
@@ -69,6 +70,10 @@ struct PdqnSettings {
   // samples that took k.
   bool indexed_loss = false;
   bool zero_index_gradients = false;
+  // P-DQN only (MP-DQN's passes give it already): each action's parameters step on that action's
+  // own Q alone, the gradient of Σ_k Q(s, k, x_k(s), x_-k(s) held fixed), so that no action's
+  // value moves another's parameters. One input back-propagation per action with parameters.
+  bool own_action_gradients = false;
 
   static PdqnSettings from(const AlgorithmParams& params);
 };
@@ -175,6 +180,9 @@ class Pdqn final : public Algorithm {
   void targets(const BatchView& batch, int B);
   double q_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
   double param_step_gradient(const BatchView& batch, int B, UpdateStats& stats);
+  // pdqn.own_action_gradients: d_x_ from one input back-propagation per action, of that action's
+  // Q over the samples whose loss holds it, kept on that action's parameters alone.
+  void own_action_gradients(const Eigen::Ref<const Eigen::MatrixXf>& states, int B, float per_sample);
   void schedule_learning_rates();
   // Restarts the average at the online networks, as of updates_.
   void reset_average();

@@ -1,6 +1,6 @@
 // P-DQN and MP-DQN (learner/pdqn.hpp): finite-difference checks of both losses' gradients,
 // hand-computed losses (the taken action, the masked max, MP-DQN's one-action passes, the indexed
-// loss), the zeroed gradients of the actions not taken, the
+// loss), the zeroed gradients of the actions not taken, each action's parameters on its own Q, the
 // actors' acting policy against the learner's own act(), and the toy task learned end to end
 // through `pamdp train`, resumed bit for bit.
 #include "learner/pdqn.hpp"
@@ -253,6 +253,65 @@ TEST(Pdqn, ZeroIndexGradientsKeepOnlyTheTakenActionsParameters) {
       EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd)) << "p2's weight " << h;
     }
   }
+}
+
+// pdqn.own_action_gradients (P-DQN's single pass): the gradient on the parameter network's output
+// row p is that of action owner(p)'s Q alone, -(1 / B) Σ_j Q(s_j, owner(p), x(s_j)), by finite
+// differences through the learner's own act(); it is not the summed loss's (whose cross-terms
+// it drops), and a parameter-free action's Q moves nothing. For MP-DQN it changes nothing.
+TEST(Pdqn, OwnActionGradientsStepEachActionsParametersOnItsOwnQ) {
+  ActionSpace space = test_space();
+  for (ParamSpec& p : space.params) {
+    p.lo = -10.0F;
+    p.hi = 10.0F;
+  }
+  PdqnSettings own;
+  own.own_action_gradients = true;
+  Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, false, {}, own);
+  Pdqn summed(kObs, space, small(BoundMethod::kZeroing), 5, false);
+  const Batch b;
+  const BatchView v = b.view();
+  EXPECT_DOUBLE_EQ(pdqn.losses(v).param_loss, summed.losses(v).param_loss);
+  pdqn.gradients(v);
+  summed.gradients(v);
+  Mlp<float>& net = pdqn.param_net();
+  const int last = static_cast<int>(net.widths().size()) - 2;
+  auto w = net.weight(last);
+  std::vector<float> out(6);
+  const auto own_q_loss = [&](int k) {
+    double l = 0.0;
+    for (int j = 0; j < kB; ++j) {
+      pdqn.act({b.states.col(j).data(), kObs}, out, ActorCopy::kOnline);
+      l -= out[static_cast<size_t>(k)] / kB;
+    }
+    return l;
+  };
+  float differs = 0.0F;
+  for (int p = 0; p < 3; ++p) {
+    const int owner = p == 0 ? 0 : 1;  // "one" owns p0, "two" p1 and p2
+    const std::vector<float> g = output_row_grads(net, p);
+    const std::vector<float> s = output_row_grads(summed.param_net(), p);
+    for (int h = 0; h < w.cols(); ++h) {
+      const float keep = w(p, h);
+      w(p, h) = keep + 1e-3F;
+      const double up = own_q_loss(owner);
+      w(p, h) = keep - 1e-3F;
+      const double down = own_q_loss(owner);
+      w(p, h) = keep;
+      const double fd = (up - down) / 2e-3;
+      EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd)) << "parameter " << p << ", weight " << h;
+      differs = std::max(differs, std::abs(g[static_cast<size_t>(h)] - s[static_cast<size_t>(h)]));
+    }
+  }
+  EXPECT_GT(differs, 1e-3F) << "the summed loss's cross-terms were not dropped";
+  // MP-DQN: each pass sees only its own action's parameters, so the option changes nothing.
+  Pdqn mp_own(kObs, space, small(BoundMethod::kZeroing), 5, true, {}, own);
+  Pdqn mp(kObs, space, small(BoundMethod::kZeroing), 5, true);
+  mp_own.gradients(v);
+  mp.gradients(v);
+  const std::vector<float> a(mp_own.param_net().grads().begin(), mp_own.param_net().grads().end());
+  const std::vector<float> c(mp.param_net().grads().begin(), mp.param_net().grads().end());
+  EXPECT_EQ(a, c);
 }
 
 // A gated action (exploration.gated_actions; here "one", open where state feature 0 > 0): where
