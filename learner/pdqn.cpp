@@ -81,8 +81,9 @@ std::vector<AlgorithmKey> pdqn_keys() {
                             "the parameter loss takes each sample's taken action alone, not the sum over actions"),
       AlgorithmKey::boolean(kZeroIndexGradients, false,
                             "the parameter step moves only the taken action's parameters of each sample"),
-      AlgorithmKey::boolean(kOwnActionGradients, false,
-                            "P-DQN: each action's parameters step on that action's own Q alone (MP-DQN has it already)"),
+      AlgorithmKey::boolean(
+          kOwnActionGradients, false,
+          "P-DQN: each action's parameters step on that action's own Q alone (MP-DQN has it already)"),
   };
 }
 
