@@ -225,7 +225,8 @@ TEST(OptimAllocations, StepClipAndSoftUpdateAllocateNothing) {
 }
 
 // P-DQN and MP-DQN: update() and act() allocate nothing, with HFO's Tackle masked (MP-DQN skips
-// its pass) and with the pass-through layer.
+// its pass), and with the pass-through layer together with the indexed loss, the zeroed index
+// gradients and the own-action gradients (one input back-propagation per action).
 TEST(PdqnAllocations, UpdateAndActAllocateNothing) {
   if (!kCounting) {
     GTEST_SKIP() << "AddressSanitizer owns malloc";
@@ -241,6 +242,9 @@ TEST(PdqnAllocations, UpdateAndActAllocateNothing) {
       c.mc_mix = 0.5;
       PdqnSettings settings;
       settings.passthrough = passthrough;
+      settings.indexed_loss = passthrough;
+      settings.zero_index_gradients = passthrough;
+      settings.own_action_gradients = passthrough;
       settings.reward_scale = 0.02;
       Pdqn p(obs, space, c, 3, multipass, {hfo::kTackle}, settings, &prior);
       const bench::RandomHfoBatch data(c.batch_size, 4);
@@ -258,7 +262,7 @@ TEST(PdqnAllocations, UpdateAndActAllocateNothing) {
         allocations = scope.count();
       }
       EXPECT_EQ(allocations, 0) << (multipass ? "mpdqn" : "pdqn")
-                                << (passthrough ? " with the pass-through layer" : "");
+                                << (passthrough ? " with the pass-through layer and the gradient options" : "");
     }
   }
 }
