@@ -60,15 +60,21 @@ void expect_gradients(Mlp<float>& net, const std::function<double()>& loss, cons
   EXPECT_GT(largest, 1e-2) << what << ": the loss does not depend on these parameters";
 }
 
+// test_space() with every parameter over [-10, 10], so that zeroing leaves every gradient alone.
+ActionSpace wide_space() {
+  ActionSpace space = test_space();
+  for (ParamSpec& p : space.params) {
+    p.lo = -10.0F;
+    p.hi = 10.0F;
+  }
+  return space;
+}
+
 class PdqnGradients : public ::testing::TestWithParam<std::tuple<bool, BoundMethod>> {};
 
 TEST_P(PdqnGradients, MatchFiniteDifferences) {
   const auto [multipass, bound] = GetParam();
-  ActionSpace space = test_space();
-  for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
-    p.lo = -10.0F;
-    p.hi = 10.0F;
-  }
+  const ActionSpace space = wide_space();
   Pdqn pdqn(kObs, space, small(bound), 3, multipass, /*masked_actions=*/{2});
   // Targets unlike the online networks, so the target term is not the online one.
   Rng rng(11);
@@ -149,11 +155,7 @@ TEST(Pdqn, LossesByHand) {
 // gradient against finite differences.
 TEST(Pdqn, IndexedLossByHandAndFiniteDifferences) {
   for (const bool multipass : {false, true}) {
-    ActionSpace space = test_space();
-    for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
-      p.lo = -10.0F;
-      p.hi = 10.0F;
-    }
+    const ActionSpace space = wide_space();
     PdqnSettings settings;
     settings.indexed_loss = true;
     Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, multipass, /*masked_actions=*/{1}, settings);
@@ -193,16 +195,30 @@ std::vector<float> output_row_grads(Mlp<float>& net, int p) {
   return g;
 }
 
+// Central differences of `loss` in the weights of the parameter network's output row p against
+// the gradient left there (output_row_grads, its bias last), within expect_gradients' tolerance.
+void expect_output_row_gradients(Mlp<float>& net, int p, const std::function<double()>& loss, const char* what) {
+  const std::vector<float> g = output_row_grads(net, p);
+  auto w = net.weight(static_cast<int>(net.widths().size()) - 2);
+  for (int h = 0; h < w.cols(); ++h) {
+    const float keep = w(p, h);
+    w(p, h) = keep + 1e-3F;
+    const double up = loss();
+    w(p, h) = keep - 1e-3F;
+    const double down = loss();
+    w(p, h) = keep;
+    const double fd = (up - down) / 2e-3;
+    EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd))
+        << what << ": parameter " << p << ", weight " << h;
+  }
+}
+
 // pdqn.zero_index_gradients: on a batch whose samples all took one action, the parameter step
 // leaves the gradient of that action's own parameters as it was (the loss's own, by finite
 // differences) and zeroes every other parameter's; the loss itself is unchanged.
 TEST(Pdqn, ZeroIndexGradientsKeepOnlyTheTakenActionsParameters) {
   for (const bool multipass : {false, true}) {
-    ActionSpace space = test_space();
-    for (ParamSpec& p : space.params) {
-      p.lo = -10.0F;
-      p.hi = 10.0F;
-    }
+    const ActionSpace space = wide_space();
     PdqnSettings zeroed;
     zeroed.zero_index_gradients = true;
     for (const int taken : {0, 1, 2}) {  // "one" owns p0, "two" p1 and p2, "none" nothing
@@ -238,19 +254,9 @@ TEST(Pdqn, ZeroIndexGradientsKeepOnlyTheTakenActionsParameters) {
     b.actions.row(1).setConstant(2.0F);
     const BatchView v = b.view();
     zero.gradients(v);
-    Mlp<float>& net = zero.param_net();
-    const int last = static_cast<int>(net.widths().size()) - 2;
-    auto w = net.weight(last);
-    const std::vector<float> g = output_row_grads(net, 2);
-    for (int h = 0; h < w.cols(); ++h) {
-      const float keep = w(2, h);
-      w(2, h) = keep + 1e-3F;
-      const double up = zero.losses(v).param_loss;
-      w(2, h) = keep - 1e-3F;
-      const double down = zero.losses(v).param_loss;
-      w(2, h) = keep;
-      const double fd = (up - down) / 2e-3;
-      EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd)) << "p2's weight " << h;
+    for (const int p : {1, 2}) {
+      expect_output_row_gradients(
+          zero.param_net(), p, [&] { return zero.losses(v).param_loss; }, "zeroed index gradients");
     }
   }
 }
@@ -260,11 +266,7 @@ TEST(Pdqn, ZeroIndexGradientsKeepOnlyTheTakenActionsParameters) {
 // differences through the learner's own act(); it is not the summed loss's (whose cross-terms
 // it drops), and a parameter-free action's Q moves nothing. For MP-DQN it changes nothing.
 TEST(Pdqn, OwnActionGradientsStepEachActionsParametersOnItsOwnQ) {
-  ActionSpace space = test_space();
-  for (ParamSpec& p : space.params) {
-    p.lo = -10.0F;
-    p.hi = 10.0F;
-  }
+  const ActionSpace space = wide_space();
   PdqnSettings own;
   own.own_action_gradients = true;
   Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, false, {}, own);
@@ -274,9 +276,6 @@ TEST(Pdqn, OwnActionGradientsStepEachActionsParametersOnItsOwnQ) {
   EXPECT_DOUBLE_EQ(pdqn.losses(v).param_loss, summed.losses(v).param_loss);
   pdqn.gradients(v);
   summed.gradients(v);
-  Mlp<float>& net = pdqn.param_net();
-  const int last = static_cast<int>(net.widths().size()) - 2;
-  auto w = net.weight(last);
   std::vector<float> out(6);
   const auto own_q_loss = [&](int k) {
     double l = 0.0;
@@ -289,18 +288,12 @@ TEST(Pdqn, OwnActionGradientsStepEachActionsParametersOnItsOwnQ) {
   float differs = 0.0F;
   for (int p = 0; p < 3; ++p) {
     const int owner = p == 0 ? 0 : 1;  // "one" owns p0, "two" p1 and p2
-    const std::vector<float> g = output_row_grads(net, p);
+    expect_output_row_gradients(
+        pdqn.param_net(), p, [&] { return own_q_loss(owner); }, "own-action gradients");
+    const std::vector<float> g = output_row_grads(pdqn.param_net(), p);
     const std::vector<float> s = output_row_grads(summed.param_net(), p);
-    for (int h = 0; h < w.cols(); ++h) {
-      const float keep = w(p, h);
-      w(p, h) = keep + 1e-3F;
-      const double up = own_q_loss(owner);
-      w(p, h) = keep - 1e-3F;
-      const double down = own_q_loss(owner);
-      w(p, h) = keep;
-      const double fd = (up - down) / 2e-3;
-      EXPECT_NEAR(g[static_cast<size_t>(h)], fd, 3e-3 + 0.03 * std::abs(fd)) << "parameter " << p << ", weight " << h;
-      differs = std::max(differs, std::abs(g[static_cast<size_t>(h)] - s[static_cast<size_t>(h)]));
+    for (size_t i = 0; i < g.size(); ++i) {
+      differs = std::max(differs, std::abs(g[i] - s[i]));
     }
   }
   EXPECT_GT(differs, 1e-3F) << "the summed loss's cross-terms were not dropped";
@@ -320,11 +313,7 @@ TEST(Pdqn, OwnActionGradientsStepEachActionsParametersOnItsOwnQ) {
 // all three. Both losses by hand, and their gradients against finite differences.
 TEST(Pdqn, GatesByHand) {
   for (const bool multipass : {false, true}) {
-    ActionSpace space = test_space();
-    for (ParamSpec& p : space.params) {  // wide, so that zeroing leaves every gradient alone
-      p.lo = -10.0F;
-      p.hi = 10.0F;
-    }
+    const ActionSpace space = wide_space();
     Pdqn pdqn(kObs, space, small(BoundMethod::kZeroing), 5, multipass);
     pdqn.set_gates({{0, 0}});
     Rng rng(11);
@@ -581,11 +570,7 @@ TEST(Pdqn, PassthroughStartsAtThePriorAndStaysFixed) {
 }
 
 TEST(Pdqn, PassthroughGradientsMatchFiniteDifferences) {
-  ActionSpace space = test_space();
-  for (ParamSpec& p : space.params) {
-    p.lo = -10.0F;
-    p.hi = 10.0F;
-  }
+  const ActionSpace space = wide_space();
   const ParameterPrior prior = random_prior(8);
   for (const BoundMethod bound : {BoundMethod::kZeroing, BoundMethod::kSquashing}) {
     Pdqn pdqn(kObs, space, small(bound), 3, true, {2}, with_passthrough(0.0F), &prior);
