@@ -39,8 +39,13 @@ Vec2 unit_or_x(Vec2 v) {
 }  // namespace
 
 void write_features(const SoccerState& state, std::span<float> out) {
+  write_features(state, 0, out);
+}
+
+void write_features(const SoccerState& state, int self_index, std::span<float> out) {
   assert(static_cast<int>(out.size()) == feature_count(state.num_players));
-  const PlayerState& self = state.players[0];
+  assert(self_index >= 0 && self_index < state.num_players);
+  const PlayerState& self = state.players[self_index];
   const double body_rad = self.body_deg * kDegToRad;
   const Vec2 b{std::cos(body_rad), std::sin(body_rad)};
   const double R = kMaxDistance;
@@ -96,8 +101,10 @@ void write_features(const SoccerState& state, std::span<float> out) {
   }
   std::array<int, SoccerState::kMaxPlayers> order{};
   int n = 0;
-  for (int i = 1; i < state.num_players; ++i) {
-    order[n++] = i;
+  for (int i = 0; i < state.num_players; ++i) {
+    if (i != self_index) {
+      order[n++] = i;
+    }
   }
   const Team my_team = self.team;
   std::sort(order.begin(), order.begin() + n, [&](int a, int c) {
@@ -108,13 +115,15 @@ void write_features(const SoccerState& state, std::span<float> out) {
     if (ta != tc) {
       return ta;
     }
-    return (pa.pos - p).r2() < (pc.pos - p).r2();
+    const double da = (pa.pos - p).r2();
+    const double dc = (pc.pos - p).r2();
+    return da != dc ? da < dc : a < c;
   });
   float* block = f + kNumAgentFeatures;
   std::fill(block, block + static_cast<ptrdiff_t>(kFeaturesPerPlayer) * others, 0.0F);
   int teammates = 0;
-  for (int i = 1; i < state.num_players; ++i) {
-    teammates += state.players[i].team == my_team ? 1 : 0;
+  for (int k = 0; k < n; ++k) {
+    teammates += state.players[order[k]].team == my_team ? 1 : 0;
   }
   int written_team = 0;
   int written_opp = 0;

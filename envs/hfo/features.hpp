@@ -57,8 +57,11 @@ constexpr int feature_count(int num_players) {
   return kNumAgentFeatures + kFeaturesPerPlayer * (num_players - 1);
 }
 
-// Writes the agent's features; `out` must hold feature_count(state.num_players) floats.
+// Writes the features of players[self] (the agent: 0): its own 58, then a block for each other
+// player, its teammates first, then its opponents, each group nearest first, as HFO's
+// LowLevelFeatureExtractor orders them. `out` must hold feature_count(state.num_players) floats.
 void write_features(const SoccerState& state, std::span<float> out);
+void write_features(const SoccerState& state, int self, std::span<float> out);
 
 // Metres represented by one unit of proximity feature (2 / R = 0.031975 per metre).
 double proximity_to_distance(float proximity);

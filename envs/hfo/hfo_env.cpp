@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "envs/hfo/hfo_team_env.hpp"
+
 namespace pamdp::hfo {
 namespace {
 
@@ -121,26 +123,10 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, const Pl
 }
 
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {
-  if (action.params.size() < static_cast<size_t>(action_space().num_params())) {
-    misuse("step(): the parameter vector must hold the 6 HFO parameters (8 with env.shoot_action)");
-  }
   if (episode_over_) {
     misuse("step() after a terminal status; call reset() first");
   }
-  const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
-  switch (action.id) {
-    case kDash: sim_.dash(p(param::kDashPower), p(param::kDashDir)); break;
-    case kTurn: sim_.turn(p(param::kTurnDir)); break;
-    case kTackle: sim_.tackle(p(param::kTackleDir)); break;
-    case kKick: sim_.kick(p(param::kKickPower), p(param::kKickDir)); break;
-    case kShoot:
-      if (!shoot_) {
-        misuse("step(): SHOOT (4) needs env.shoot_action");
-      }
-      sim_.kick(p(param::kShootPower), p(param::kShootDir));
-      break;
-    default: misuse("step(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK, 4 SHOOT)");
-  }
+  play_action(sim_, 0, action, shoot_);
   const int status = sim_.step();
   episode_over_ = status != kInGame;
   write_features(sim_.state(), obs);

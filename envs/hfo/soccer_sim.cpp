@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
 #include <string_view>
 
 #include "envs/hfo/client_effector.hpp"
@@ -64,9 +67,15 @@ const char* status_name(int status) {
 }
 
 SoccerSim::SoccerSim(const SoccerSimConfig& config, uint64_t seed) : config_(config), rng_(seed) {
-  PlayerState agent;
-  agent.pos = {0.0, 0.0};
-  set_state(agent, BallState{{10.0, 0.0}, {0.0, 0.0}});
+  if (config_.offense_agents < 1 || config_.offense_agents > kMaxOffenseAgents) {
+    throw std::invalid_argument("SoccerSim: offense_agents must be within [1, " + std::to_string(kMaxOffenseAgents) +
+                                "], got " + std::to_string(config_.offense_agents));
+  }
+  std::array<PlayerState, kMaxOffenseAgents> offense{};
+  for (int i = 0; i < config_.offense_agents; ++i) {
+    offense[i].pos = {0.0, 2.0 * i};
+  }
+  set_state(std::span<const PlayerState>(offense.data(), config_.offense_agents), BallState{{10.0, 0.0}, {0.0, 0.0}});
 }
 
 void SoccerSim::reset_episode() {
@@ -79,33 +88,50 @@ void SoccerSim::reset_episode() {
   }
   const double by = kPitchHalfWidth * rng_.uniform(-0.8, 0.8);
 
-  // Agent: one of ten offsets around the ball, then the era's clamp.
+  // Offense agents: HFORef::resetField (rcssserver referee.cpp) shuffles its ten offsets
+  // around the ball each reset and gives offset i to the i-th offense player, so no two share
+  // one; then the era's clamp. A partial Fisher-Yates shuffle draws the same distribution, and
+  // with one agent it is the single draw of one offset of ten.
   static constexpr std::array<std::array<double, 2>, 10> kOffsets{
       {{-1, -1}, {-1, 1}, {1, 1}, {1, -1}, {0, 2}, {0, -2}, {-2, -2}, {-2, 2}, {2, 2}, {2, -2}}};
-  const auto& off = kOffsets[rng_.below(kOffsets.size())];
-  double ax = bx + 10.5 * (rng_.uniform() + off[0]);
-  double ay = by + 10.5 * (rng_.uniform() + off[1]);
-  switch (config_.start) {
-    case StartDistribution::kPaper:
-      ax = clamp(ax, -0.1, kPitchHalfLength);
-      ay = clamp(ay, -kPitchHalfWidth, kPitchHalfWidth);
-      break;
-    case StartDistribution::kDec2015:
-      ax = clamp(ax, -0.1, 21.0);
-      ay = clamp(ay, -27.2, 27.2);
-      break;
-    case StartDistribution::kHfo:
-      ax = clamp(ax, -0.1, kPitchHalfLength);
-      ay = clamp(ay, -27.2, 27.2);
-      break;
+  const int n = config_.offense_agents;
+  std::array<int, kOffsets.size()> pick{};
+  for (int i = 0; i < static_cast<int>(pick.size()); ++i) {
+    pick[i] = i;
   }
-
-  PlayerState& agent = state_.players[0];
-  double body = agent.body_deg;
-  switch (config_.body_at_reset) {
-    case BodyAtReset::kCarry: body = first_episode_ ? 0.0 : agent.body_deg; break;
-    case BodyAtReset::kZero: body = 0.0; break;
-    case BodyAtReset::kUniform: body = wrap_deg(rng_.uniform(-180.0, 180.0)); break;
+  for (int i = 0; i < n; ++i) {
+    const int j = i + static_cast<int>(rng_.below(pick.size() - i));
+    std::swap(pick[i], pick[j]);
+  }
+  std::array<PlayerState, kMaxOffenseAgents> offense{};
+  for (int i = 0; i < n; ++i) {
+    const auto& off = kOffsets[pick[i]];
+    double ax = bx + 10.5 * (rng_.uniform() + off[0]);
+    double ay = by + 10.5 * (rng_.uniform() + off[1]);
+    switch (config_.start) {
+      case StartDistribution::kPaper:
+        ax = clamp(ax, -0.1, kPitchHalfLength);
+        ay = clamp(ay, -kPitchHalfWidth, kPitchHalfWidth);
+        break;
+      case StartDistribution::kDec2015:
+        ax = clamp(ax, -0.1, 21.0);
+        ay = clamp(ay, -27.2, 27.2);
+        break;
+      case StartDistribution::kHfo:
+        ax = clamp(ax, -0.1, kPitchHalfLength);
+        ay = clamp(ay, -27.2, 27.2);
+        break;
+    }
+    offense[i].pos = {ax, ay};
+  }
+  for (int i = 0; i < n; ++i) {
+    double body = state_.players[i].body_deg;
+    switch (config_.body_at_reset) {
+      case BodyAtReset::kCarry: body = first_episode_ ? 0.0 : body; break;
+      case BodyAtReset::kZero: body = 0.0; break;
+      case BodyAtReset::kUniform: body = wrap_deg(rng_.uniform(-180.0, 180.0)); break;
+    }
+    offense[i].body_deg = body;
   }
   first_episode_ = false;
 
@@ -115,30 +141,41 @@ void SoccerSim::reset_episode() {
   // ban run on, and so does its own catch memory. The cycle the server waits after the
   // terminal state (HFORef::analyse) counts for them; the goalie's command in that cycle is
   // not played here.
-  const PlayerState old_goalie = state_.players[kGoalieIndex];
-  PlayerState fresh;
-  fresh.pos = {ax, ay};
-  fresh.body_deg = body;
-  set_state(fresh, BallState{{bx, by}, {0.0, 0.0}});
+  const PlayerState old_goalie = state_.players[goalie_index()];
+  set_state(std::span<const PlayerState>(offense.data(), n), BallState{{bx, by}, {0.0, 0.0}});
   if (!config_.goalie) {
     return;
   }
-  PlayerState& g = state_.players[kGoalieIndex];
+  PlayerState& g = state_.players[goalie_index()];
   g.body_deg = old_goalie.body_deg;  // the constructor's set_state gave it 180 to start
   g.tackle_cycles = std::max(0, old_goalie.tackle_cycles - 1);
   g.catch_ban = std::max(0, old_goalie.catch_ban - 1);
   g.since_catch = std::min(PlayerState::kNoCatchYet, old_goalie.since_catch + 1);
   // HFO's client plays NOOPs for the first two cycles of an episode, so its first observation
   // comes two cycles after the reset (docs/hfo-server.md); the goalie plays in both. Only the
-  // goalie moves: the ball is at rest and the agent sends nothing.
+  // goalie moves: the ball is at rest and the agents send nothing.
   for (int i = 0; i < kCyclesBeforeFirstObservation; ++i) {
     step();
   }
 }
 
 void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
-  state_.players[0] = agent;
-  state_.players[0].body_deg = wrap_deg(agent.body_deg);
+  set_state(std::span<const PlayerState>(&agent, 1), ball);
+}
+
+void SoccerSim::set_state(std::span<const PlayerState> offense, const BallState& ball) {
+  const int n = config_.offense_agents;
+  if (static_cast<int>(offense.size()) != n) {
+    throw std::invalid_argument("SoccerSim::set_state: " + std::to_string(offense.size()) +
+                                " offense players given, the sim has offense_agents = " + std::to_string(n));
+  }
+  for (int i = 0; i < n; ++i) {
+    state_.players[i] = offense[i];
+    state_.players[i].body_deg = wrap_deg(offense[i].body_deg);
+    state_.players[i].team = Team::kOffense;
+    state_.players[i].goalie = false;
+  }
+  state_.num_players = n;
   state_.ball = ball;
   state_.cycle = 0;
   state_.untouched = 0;
@@ -153,8 +190,8 @@ void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
     goalie.body_deg = kGoalieStartBodyDeg;
     goalie.team = Team::kDefense;
     goalie.goalie = true;
-    state_.players[kGoalieIndex] = goalie;
-    state_.num_players = kGoalieIndex + 1;
+    state_.players[goalie_index()] = goalie;
+    state_.num_players = goalie_index() + 1;
   }
   player_accel_.fill(Vec2{});
   ball_accel_ = {};
@@ -163,7 +200,7 @@ void SoccerSim::set_state(const PlayerState& agent, const BallState& ball) {
 }
 
 void SoccerSim::set_goalie(const PlayerState& goalie) {
-  PlayerState& g = state_.players[kGoalieIndex];
+  PlayerState& g = state_.players[goalie_index()];
   const Team team = g.team;
   const bool is_goalie = g.goalie;
   g = goalie;
@@ -172,8 +209,16 @@ void SoccerSim::set_goalie(const PlayerState& goalie) {
   g.body_deg = wrap_deg(goalie.body_deg);
 }
 
-bool SoccerSim::agent_kickable() const {
-  return (state_.ball.pos - agent().pos).r() <= kClientKickableArea;
+bool SoccerSim::kickable(int player) const {
+  return (state_.ball.pos - state_.players[player].pos).r() <= kClientKickableArea;
+}
+
+void SoccerSim::check_offense_player(int player) const {
+  if (player < 0 || player >= config_.offense_agents) {
+    std::fprintf(stderr, "SoccerSim: command for player %d, but the offense agents are 0..%d\n", player,
+                 config_.offense_agents - 1);
+    std::abort();
+  }
 }
 
 Vec2 SoccerSim::noise_vector(double max_radius) {
@@ -184,21 +229,46 @@ Vec2 SoccerSim::noise_vector(double max_radius) {
 }
 
 bool SoccerSim::dash(double power, double dir_deg) {
-  sense_goalie();
   return dash_player(0, power, dir_deg);
 }
 
 bool SoccerSim::turn(double dir_deg) {
-  sense_goalie();
   return turn_player(0, dir_deg);
 }
 
 bool SoccerSim::kick(double power, double dir_deg) {
-  sense_goalie();
   return kick_player(0, power, dir_deg);
 }
 
-bool SoccerSim::dash_player(int i, double power, double dir_deg) {
+bool SoccerSim::tackle(double dir_deg) {
+  return tackle_player(0, dir_deg);
+}
+
+bool SoccerSim::dash_player(int player, double power, double dir_deg) {
+  check_offense_player(player);
+  sense_goalie();
+  return send_dash(player, power, dir_deg);
+}
+
+bool SoccerSim::turn_player(int player, double dir_deg) {
+  check_offense_player(player);
+  sense_goalie();
+  return send_turn(player, dir_deg);
+}
+
+bool SoccerSim::kick_player(int player, double power, double dir_deg) {
+  check_offense_player(player);
+  sense_goalie();
+  return send_kick(player, power, dir_deg);
+}
+
+bool SoccerSim::tackle_player(int player, double dir_deg) {
+  check_offense_player(player);
+  sense_goalie();
+  return server_tackle(player, dir_deg);
+}
+
+bool SoccerSim::send_dash(int i, double power, double dir_deg) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
@@ -226,7 +296,7 @@ bool SoccerSim::server_dash(int i, double power, double dir) {
   return true;
 }
 
-bool SoccerSim::turn_player(int i, double dir_deg) {
+bool SoccerSim::send_turn(int i, double dir_deg) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
@@ -249,7 +319,7 @@ bool SoccerSim::server_turn(int i, double moment) {
   return true;
 }
 
-bool SoccerSim::kick_player(int i, double power, double dir_deg) {
+bool SoccerSim::send_kick(int i, double power, double dir_deg) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
@@ -286,12 +356,7 @@ bool SoccerSim::kick_player_server(int i, double power, double dir_deg) {
   return true;
 }
 
-bool SoccerSim::tackle(double dir_deg) {
-  sense_goalie();
-  return tackle_player(0, dir_deg);
-}
-
-bool SoccerSim::tackle_player(int i, double dir_deg) {
+bool SoccerSim::server_tackle(int i, double dir_deg) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
@@ -387,7 +452,7 @@ bool SoccerSim::command_as_received(int player, const char* kind, double p1, dou
     return kick_player_server(player, p1, p2);
   }
   if (k == "TACKLE") {
-    return tackle_player(player, p1);
+    return server_tackle(player, p1);
   }
   if (k == "CATCH") {
     return goalie_catch(player, p1);
@@ -399,7 +464,7 @@ void SoccerSim::sense_goalie() {
   if (!config_.goalie || goalie_sensed_) {
     return;
   }
-  const GoalieCommand c = decide_goalie(state_, kGoalieIndex, config_.noise);
+  const GoalieCommand c = decide_goalie(state_, goalie_index(), config_.noise);
   pending_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
   goalie_sensed_ = true;
 }
@@ -407,19 +472,20 @@ void SoccerSim::sense_goalie() {
 void SoccerSim::play_goalie() {
   sense_goalie();
   goalie_sensed_ = false;
-  PlayerState& g = state_.players[kGoalieIndex];
+  const int gi = goalie_index();
+  PlayerState& g = state_.players[gi];
   last_goalie_command_ = pending_goalie_command_;
   const GoalieCommand c{static_cast<GoalieCommand::Kind>(pending_goalie_command_.kind), pending_goalie_command_.p1,
                         pending_goalie_command_.p2};
   switch (c.kind) {
-    case GoalieCommand::Kind::kDash: server_dash(kGoalieIndex, c.p1, c.p2); break;
-    case GoalieCommand::Kind::kTurn: server_turn(kGoalieIndex, c.p1); break;
+    case GoalieCommand::Kind::kDash: server_dash(gi, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTurn: server_turn(gi, c.p1); break;
     case GoalieCommand::Kind::kCatch:
       g.since_catch = 0;
-      goalie_catch(kGoalieIndex, c.p1);
+      goalie_catch(gi, c.p1);
       break;
-    case GoalieCommand::Kind::kKick: kick_player(kGoalieIndex, c.p1, c.p2); break;
-    case GoalieCommand::Kind::kTackle: tackle_player(kGoalieIndex, c.p1); break;
+    case GoalieCommand::Kind::kKick: send_kick(gi, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTackle: server_tackle(gi, c.p1); break;
     case GoalieCommand::Kind::kNone: break;
   }
 }

@@ -2,12 +2,14 @@
 // referee for Half Field Offense, as specified in shared/hfo-reference.md (§1, §2, §5).
 //
 // It owns no socket and no global state: construct as many as you like, one per thread.
-// Every call below is O(players) and allocates nothing. The agent the features describe is
-// players()[0]. With SoccerSimConfig::goalie, players()[1] is the hand-coded NPC goalie of
-// envs/hfo/goalie.hpp: it decides from the state at the start of every step() and its command
-// goes through the same client and server handling as the agent's (dash, turn), plus the
-// goalie's catch. More players have room in the state and take part in physics, the referee
-// and the features, but have no command interface.
+// Every call below is O(players) and allocates nothing. players()[0 .. offense_agents - 1]
+// are the learned offense players (HFO's --offense-agents N), each commanded through the
+// *_player calls; the single-agent calls (dash, turn, ...) command players()[0], the agent
+// the 1v0 and 1v1 features describe. With SoccerSimConfig::goalie, players()[goalie_index()]
+// (= offense_agents) is the NPC goalie of envs/hfo/goalie.hpp: it decides from the state at
+// the start of every step() and its command goes through the same client and server handling
+// as the agents' (dash, turn), plus the goalie's catch. Commands of several players in one
+// cycle add up as the server's do: two kicks push the ball with the sum of their accelerations.
 //
 // Units: metres, metres per cycle, degrees for every angle in this API (the server works in
 // radians internally; commands and features use degrees).
@@ -60,9 +62,13 @@ struct SoccerSimConfig {
   int max_steps = 500;        // --frames-per-trial used by dqn-hfo
   int untouched_limit = 100;  // cycles the ball may stay untouched
   bool goalie = false;        // an NPC goalie defends the goal (1v1): players()[1], 66 features
+  // Learned offense players, HFO's --offense-agents (1-4): players()[0 .. offense_agents - 1].
+  int offense_agents = 1;
 };
 
-// Index of the NPC goalie in SoccerState::players when SoccerSimConfig::goalie is on.
+inline constexpr int kMaxOffenseAgents = 4;
+// Index of the NPC goalie in SoccerState::players when SoccerSimConfig::goalie is on and there
+// is one offense agent; in general SoccerSim::goalie_index() (= offense_agents).
 inline constexpr int kGoalieIndex = 1;
 // Where HFO puts the goalie at every reset (reference §5.1), facing the field.
 inline constexpr Vec2 kGoalieStart{kPitchHalfLength, 0.0};
@@ -104,7 +110,7 @@ struct BallState {
 
 // Everything the physics and the referee need to continue an episode.
 struct SoccerState {
-  static constexpr int kMaxPlayers = 4;
+  static constexpr int kMaxPlayers = 8;  // 4 offense agents, the goalie, room for defenders
   std::array<PlayerState, kMaxPlayers> players{};
   int num_players = 1;
   BallState ball;
@@ -126,6 +132,9 @@ class SoccerSim {
 
   // Replaces the state (tests, traces). Referee counters restart at this state; with a goalie
   // configured, the goalie is put back at its start (kGoalieStart, at rest, full stamina).
+  // `offense` holds one state per offense agent (config().offense_agents of them; throws
+  // std::invalid_argument otherwise); the single-agent form needs offense_agents = 1.
+  void set_state(std::span<const PlayerState> offense, const BallState& ball);
   void set_state(const PlayerState& agent, const BallState& ball);
   // Replaces the goalie's state after set_state (traces); its team and role are kept.
   void set_goalie(const PlayerState& goalie);
@@ -133,6 +142,9 @@ class SoccerSim {
   SoccerState& mutable_state() { return state_; }
   [[nodiscard]] const PlayerState& agent() const { return state_.players[0]; }
   [[nodiscard]] const SoccerSimConfig& config() const { return config_; }
+  [[nodiscard]] int offense_agents() const { return config_.offense_agents; }
+  // Index of the goalie in state().players (meaningful with config().goalie).
+  [[nodiscard]] int goalie_index() const { return config_.offense_agents; }
 
   // Agent commands, as the HFO agent issues them through librcsc (client-side clamping,
   // wrapping, gating and compensation, then the server's handling). At most one per cycle;
@@ -141,6 +153,12 @@ class SoccerSim {
   bool turn(double dir_deg);
   bool tackle(double dir_deg);
   bool kick(double power, double dir_deg);
+  // The same for offense agent `player` (0 .. offense_agents - 1; a bad index is a programming
+  // error and stops the process). Each agent sends at most one of these per cycle.
+  bool dash_player(int player, double power, double dir_deg);
+  bool turn_player(int player, double dir_deg);
+  bool tackle_player(int player, double dir_deg);
+  bool kick_player(int player, double power, double dir_deg);
 
   // The goalie's catch (rcssserver Player::goalieCatch with the defaults of geometry.hpp, in
   // HFO mode): refused unless `player` is a goalie whose catch ban is over; sets the ban;
@@ -169,16 +187,18 @@ class SoccerSim {
   int step();
 
   // Client kickable rule (reference §2.7): distance agent-ball <= 1.03.
-  [[nodiscard]] bool agent_kickable() const;
+  [[nodiscard]] bool agent_kickable() const { return kickable(0); }
+  [[nodiscard]] bool kickable(int player) const;
 
  private:
-  bool dash_player(int i, double power, double dir_deg);
-  bool turn_player(int i, double dir_deg);
-  bool kick_player(int i, double power, double dir_deg);
+  void check_offense_player(int player) const;
+  bool send_dash(int i, double power, double dir_deg);
+  bool send_turn(int i, double dir_deg);
+  bool send_kick(int i, double power, double dir_deg);
   bool kick_player_server(int i, double power, double dir_deg);
   bool server_dash(int i, double power, double dir_deg);
   bool server_turn(int i, double moment);
-  bool tackle_player(int i, double dir_deg);
+  bool server_tackle(int i, double dir_deg);
   // The goalie senses the cycle's state before any command of the cycle changes it (a turn
   // takes effect when the server receives it): decided once, at the first command or step().
   void sense_goalie();

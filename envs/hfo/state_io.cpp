@@ -53,6 +53,76 @@ void reject_unknown(const nlohmann::json& obj, const char* group, std::initializ
   }
 }
 
+PlayerState offense_player(const nlohmann::json& a, const char* group, const std::string& src) {
+  reject_unknown(a, group, {"x", "y", "vx", "vy", "body_deg", "stamina"}, src);
+  PlayerState p;
+  p.pos = {number(a, group, "x", src, {}), number(a, group, "y", src, {})};
+  p.vel = {number(a, group, "vx", src, 0.0), number(a, group, "vy", src, 0.0)};
+  p.body_deg = number(a, group, "body_deg", src, 0.0);
+  p.stamina = number(a, group, "stamina", src, kStaminaMax);
+  if (p.stamina < 0.0 || p.stamina > kStaminaMax) {
+    throw std::runtime_error(src + ": " + group + ".stamina must be within [0, 8000]");
+  }
+  return p;
+}
+
+std::string trimmed(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t");
+  const auto last = s.find_last_not_of(" \t");
+  return first == std::string::npos ? "" : s.substr(first, last - first + 1);
+}
+
+// One action, "KIND,p1[,p2]"; `where` starts every error ("file:line: ").
+ScriptedAction parse_action(const std::string& text, const std::string& where) {
+  std::vector<std::string> cells;
+  std::stringstream ls(text);
+  std::string cell;
+  while (std::getline(ls, cell, ',')) {
+    cells.push_back(trimmed(cell));
+  }
+  if (!text.empty() && text.back() == ',') {
+    cells.emplace_back();  // a trailing comma is one more (empty) cell, so the arity check sees it
+  }
+  auto num = [&](size_t i) {
+    double v = 0.0;
+    const std::string& c = cells[i];
+    const auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
+    if (ec != std::errc() || ptr != c.data() + c.size()) {
+      throw std::runtime_error(where + "'" + c + "' is not a number");
+    }
+    return static_cast<float>(v);
+  };
+  ScriptedAction a;
+  const std::string kind = cells.empty() ? trimmed(text) : cells[0];
+  auto need = [&](size_t n, const char* form) {
+    if (cells.size() != n) {
+      throw std::runtime_error(where + "expected '" + form + "', got '" + text + "'");
+    }
+  };
+  if (kind == "DASH") {
+    need(3, "DASH,power,dir");
+    a.id = kDash;
+    a.params[param::kDashPower] = num(1);
+    a.params[param::kDashDir] = num(2);
+  } else if (kind == "TURN") {
+    need(2, "TURN,dir");
+    a.id = kTurn;
+    a.params[param::kTurnDir] = num(1);
+  } else if (kind == "TACKLE") {
+    need(2, "TACKLE,dir");
+    a.id = kTackle;
+    a.params[param::kTackleDir] = num(1);
+  } else if (kind == "KICK") {
+    need(3, "KICK,power,dir");
+    a.id = kKick;
+    a.params[param::kKickPower] = num(1);
+    a.params[param::kKickDir] = num(2);
+  } else {
+    throw std::runtime_error(where + "unknown action '" + kind + "' (valid: DASH, TURN, TACKLE, KICK)");
+  }
+  return a;
+}
+
 }  // namespace
 
 InitialState parse_state_json(const std::string& text, const std::string& src) {
@@ -66,18 +136,24 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       !j["ball"].is_object()) {
     throw std::runtime_error(src + ": expected an object with \"agent\" and \"ball\" objects");
   }
-  reject_unknown(j, "", {"agent", "ball", "goalie"}, src);
-  const auto& a = j["agent"];
+  reject_unknown(j, "", {"agent", "ball", "teammates", "goalie"}, src);
   const auto& b = j["ball"];
-  reject_unknown(a, "agent", {"x", "y", "vx", "vy", "body_deg", "stamina"}, src);
   reject_unknown(b, "ball", {"x", "y", "vx", "vy"}, src);
   InitialState s;
-  s.agent.pos = {number(a, "agent", "x", src, {}), number(a, "agent", "y", src, {})};
-  s.agent.vel = {number(a, "agent", "vx", src, 0.0), number(a, "agent", "vy", src, 0.0)};
-  s.agent.body_deg = number(a, "agent", "body_deg", src, 0.0);
-  s.agent.stamina = number(a, "agent", "stamina", src, kStaminaMax);
-  if (s.agent.stamina < 0.0 || s.agent.stamina > kStaminaMax) {
-    throw std::runtime_error(src + ": agent.stamina must be within [0, 8000]");
+  s.agent = offense_player(j["agent"], "agent", src);
+  if (j.contains("teammates")) {
+    const auto& mates = j["teammates"];
+    if (!mates.is_array() || mates.size() > static_cast<size_t>(kMaxOffenseAgents - 1)) {
+      throw std::runtime_error(src + ": \"teammates\" must be an array of at most " +
+                               std::to_string(kMaxOffenseAgents - 1) + " objects (the agent is player 0)");
+    }
+    for (size_t i = 0; i < mates.size(); ++i) {
+      const std::string group = "teammates[" + std::to_string(i) + "]";
+      if (!mates[i].is_object()) {
+        throw std::runtime_error(src + ": \"" + group + "\" must be an object");
+      }
+      s.teammates.push_back(offense_player(mates[i], group.c_str(), src));
+    }
   }
   s.ball.pos = {number(b, "ball", "x", src, {}), number(b, "ball", "y", src, {})};
   s.ball.vel = {number(b, "ball", "vx", src, 0.0), number(b, "ball", "vy", src, 0.0)};
@@ -121,8 +197,11 @@ InitialState load_state_json(const std::string& path) {
   return parse_state_json(read_file(path), path);
 }
 
-std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std::string& src) {
-  std::vector<ScriptedAction> out;
+std::vector<TeamActions> parse_team_actions_csv(const std::string& text, const std::string& src, int players) {
+  if (players < 1) {
+    throw std::invalid_argument("parse_team_actions_csv: players must be >= 1");
+  }
+  std::vector<TeamActions> out;
   std::istringstream in(text);
   std::string line;
   int line_no = 0;
@@ -135,56 +214,34 @@ std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std
     if (first_char == std::string::npos || line[first_char] == '#') {
       continue;
     }
-    std::vector<std::string> cells;
-    std::stringstream ls(line);
-    std::string cell;
-    while (std::getline(ls, cell, ',')) {
-      const auto first = cell.find_first_not_of(" \t");
-      const auto last = cell.find_last_not_of(" \t");
-      cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
-    }
-    if (line.back() == ',') {
-      cells.emplace_back();  // a trailing comma is one more (empty) cell, so the arity check sees it
-    }
     const std::string where = src + ":" + std::to_string(line_no) + ": ";
-    auto num = [&](size_t i) {
-      double v = 0.0;
-      const std::string& c = cells[i];
-      const auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-      if (ec != std::errc() || ptr != c.data() + c.size()) {
-        throw std::runtime_error(where + "'" + c + "' is not a number");
+    TeamActions row;
+    size_t from = 0;
+    while (true) {
+      const size_t bar = line.find('|', from);
+      row.push_back(parse_action(line.substr(from, bar == std::string::npos ? std::string::npos : bar - from), where));
+      if (bar == std::string::npos) {
+        break;
       }
-      return static_cast<float>(v);
-    };
-    ScriptedAction a;
-    const std::string& kind = cells.empty() ? line : cells[0];
-    auto need = [&](size_t n, const char* form) {
-      if (cells.size() != n) {
-        throw std::runtime_error(where + "expected '" + form + "', got '" + line + "'");
-      }
-    };
-    if (kind == "DASH") {
-      need(3, "DASH,power,dir");
-      a.id = kDash;
-      a.params[param::kDashPower] = num(1);
-      a.params[param::kDashDir] = num(2);
-    } else if (kind == "TURN") {
-      need(2, "TURN,dir");
-      a.id = kTurn;
-      a.params[param::kTurnDir] = num(1);
-    } else if (kind == "TACKLE") {
-      need(2, "TACKLE,dir");
-      a.id = kTackle;
-      a.params[param::kTackleDir] = num(1);
-    } else if (kind == "KICK") {
-      need(3, "KICK,power,dir");
-      a.id = kKick;
-      a.params[param::kKickPower] = num(1);
-      a.params[param::kKickDir] = num(2);
-    } else {
-      throw std::runtime_error(where + "unknown action '" + kind + "' (valid: DASH, TURN, TACKLE, KICK)");
+      from = bar + 1;
     }
-    out.push_back(a);
+    if (static_cast<int>(row.size()) != players) {
+      throw std::runtime_error(where + "expected " + std::to_string(players) + " action" + (players == 1 ? "" : "s") +
+                               " separated by '|' (one per offense player), got " + std::to_string(row.size()));
+    }
+    out.push_back(std::move(row));
+  }
+  return out;
+}
+
+std::vector<TeamActions> load_team_actions_csv(const std::string& path, int players) {
+  return parse_team_actions_csv(read_file(path), path, players);
+}
+
+std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std::string& src) {
+  std::vector<ScriptedAction> out;
+  for (auto& row : parse_team_actions_csv(text, src, 1)) {
+    out.push_back(row[0]);
   }
   return out;
 }

@@ -1,15 +1,19 @@
 // Reading states and action scripts for `pamdp sim trace` and tests.
 //
 // STATE.json: {"agent": {"x", "y", "vx", "vy", "body_deg", "stamina"}, "ball": {"x", "y", "vx", "vy"},
+//              "teammates": [{"x", "y", "vx", "vy", "body_deg", "stamina"}, ...],
 //              "goalie": {"x", "y", "vx", "vy", "body_deg", "stamina", "since_catch", "tackle_cycles",
 //                         "caught"}}
 // (velocities are the observed, post-decay ones; stamina defaults to 8000, velocities to 0).
+// "teammates" is optional: the other learned offense players, players 1, 2, ... after the agent
+// (player 0), at most kMaxOffenseAgents - 1 of them.
 // "goalie" is optional; each of its keys missing takes its value at a reset (52.5, 0, at rest,
 // body 180, stamina 8000, no catch yet, not frozen); since_catch counts the cycles since its last
 // catch command, tackle_cycles the cycles its own tackle still freezes it (0-10), and caught says
 // it caught the ball earlier in the episode (it then only keeps its position until the reset).
 // ACTIONS.csv: one action per row: DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir;
-// blank lines and lines starting with '#' are skipped.
+// blank lines and lines starting with '#' are skipped. With several offense players a row holds
+// one action per player, in player order, separated by '|': DASH,80,0|KICK,60,-20.
 // Both throw std::runtime_error naming the file, line and problem.
 #pragma once
 
@@ -24,6 +28,7 @@ namespace pamdp::hfo {
 struct InitialState {
   PlayerState agent;
   BallState ball;
+  std::vector<PlayerState> teammates;  // offense players 1, 2, ...
   bool has_goalie = false;
   PlayerState goalie;  // when has_goalie
 };
@@ -38,5 +43,10 @@ struct ScriptedAction {
 
 std::vector<ScriptedAction> parse_actions_csv(const std::string& text, const std::string& source_name);
 std::vector<ScriptedAction> load_actions_csv(const std::string& path);
+
+// Rows of `players` actions each (players >= 1; one player reads the one-action format).
+using TeamActions = std::vector<ScriptedAction>;
+std::vector<TeamActions> parse_team_actions_csv(const std::string& text, const std::string& source_name, int players);
+std::vector<TeamActions> load_team_actions_csv(const std::string& path, int players);
 
 }  // namespace pamdp::hfo
