@@ -1,5 +1,8 @@
 // BM_SimStep: one embedded-HFO env step (physics + referee + 58 features + reward) driven by
 // a fixed-cost scripted action stream, items = env steps.
+// BM_SimStepTeam/N: one cycle of N offense agents against the goalie (HfoTeamEnv), each agent's
+// action, features and reward; items = cycles (issue 79's target: >= 500 k/s for 2v1, given as
+// a ratio to BM_SimStep in the same run).
 // BM_GoalStep: one Robot Soccer Goal decision step (every internal simulation step it runs, and
 // the 17 features), items = decision steps; the counter sim_steps is the internal step rate.
 #include <benchmark/benchmark.h>
@@ -11,6 +14,7 @@
 #include "core/rng.hpp"
 #include "envs/goal/goal_env.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
 
 namespace {
 
@@ -43,6 +47,33 @@ void BM_SimStepGoalie(benchmark::State& state) {
   run_sim_steps(state, {.goalie = true});
 }
 BENCHMARK(BM_SimStepGoalie);
+
+void BM_SimStepTeam(benchmark::State& state) {
+  pamdp::hfo::SoccerSimConfig config;
+  config.goalie = true;
+  config.offense_agents = static_cast<int>(state.range(0));
+  pamdp::hfo::HfoTeamEnv env(config);
+  const int n = env.agents();
+  std::vector<float> obs(static_cast<size_t>(n * env.observation_size()));
+  std::vector<float> rewards(static_cast<size_t>(n));
+  env.reset(7, obs);
+  std::array<float, 6> params{80.0F, 0.0F, 30.0F, 0.0F, 60.0F, 10.0F};
+  constexpr std::array<int, 8> kCycle{0, 0, 1, 0, 3, 0, 0, 3};
+  std::vector<pamdp::ParamAction> actions(static_cast<size_t>(n));
+  size_t k = 0;
+  for (auto _ : state) {
+    for (int i = 0; i < n; ++i) {
+      actions[static_cast<size_t>(i)] = {kCycle[(k + static_cast<size_t>(3 * i)) & 7U], params};
+    }
+    ++k;
+    if (env.step(actions, obs, rewards) != 0) {
+      env.reset(obs);
+    }
+    benchmark::DoNotOptimize(obs.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SimStepTeam)->Arg(1)->Arg(2)->Arg(4);
 
 void BM_GoalStep(benchmark::State& state) {
   pamdp::goal::GoalEnv env;

@@ -13,6 +13,7 @@
 #include "counting_new.hpp"
 #include "envs/goal/goal_env.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/platform/platform_env.hpp"
 #include "envs/scaled_parameters.hpp"
@@ -78,6 +79,38 @@ TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithoutNoise) {
 // 1v1: the NPC goalie's decision and catch run inside step().
 TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithGoalie) {
   expect_hfo_hot_path_allocation_free(true, true);
+}
+
+// 2v1 (issue 79): two offense agents, the goalie, each player's features and reward per step.
+TEST(HfoTeamEnvAllocations, StepAndResetAllocateNothing) {
+  hfo::SoccerSimConfig config;
+  config.goalie = true;
+  config.offense_agents = 2;
+  hfo::HfoTeamEnv env(config);
+  const size_t n = static_cast<size_t>(env.observation_size());
+  std::vector<float> obs(2 * n);
+  std::array<float, 2> rewards{};
+  RandomPolicy p0(env.action_space(), 3);
+  RandomPolicy p1(env.action_space(), 4);
+  env.reset(1, obs);
+  long allocations = 0;
+  int steps = 0;
+  {
+    CountAllocations scope;
+    for (int ep = 0; ep < 20; ++ep) {
+      env.reset(obs);
+      int status = 0;
+      do {
+        const std::array<ParamAction, 2> actions{p0.act(std::span<const float>(obs).first(n)),
+                                                 p1.act(std::span<const float>(obs).subspan(n, n))};
+        status = env.step(actions, obs, rewards);
+        ++steps;
+      } while (status == 0);
+    }
+    allocations = scope.count();
+  }
+  EXPECT_GT(steps, 500);
+  EXPECT_EQ(allocations, 0) << "HfoTeamEnv::step/reset allocated during " << steps << " steps";
 }
 
 // Plays `episodes` random episodes of `env` inside a counting scope (reset() and reset(seed)
