@@ -14,6 +14,7 @@
 
 #include "actor/actor_loop.hpp"
 #include "actor/learner_link.hpp"
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
@@ -181,7 +182,9 @@ void run_actor(const ActorCliOptions& o) {
 void register_actor(CLI::App& app) {
   auto o = std::make_shared<ActorCliOptions>();
   CLI::App* cmd = app.add_subcommand("actor", "act in envs for a distributed learner (docs/protocol.md)");
-  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")->required();
+  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")
+      ->required()
+      ->check(zmq_endpoint());
   cmd->add_option("--envs", o->envs, "environments stepped round robin")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();

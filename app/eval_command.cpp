@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
@@ -129,8 +130,13 @@ void print_result(const std::string& name, const EvalResult& r, bool json, const
                   const std::string& checkpoint = {}) {
   std::printf("%-10s %9s %9s %18s %12s %10s\n", "policy", "episodes", "scoring", "avg steps to goal", "mean return",
               "avg steps");
-  std::printf("%-10s %9d %9.3f %18.1f %12.3f %10.1f\n", name.c_str(), r.episodes, r.goal_rate, r.avg_steps_to_goal,
-              r.avg_return, r.avg_steps);
+  // Steps to goal only when some episode scored: an average over none is not 0 (--json keeps its 0).
+  char to_goal[32] = "-";
+  if (r.goal_rate > 0.0) {
+    std::snprintf(to_goal, sizeof(to_goal), "%.1f", r.avg_steps_to_goal);
+  }
+  std::printf("%-10s %9d %9.3f %18s %12.3f %10.1f\n", name.c_str(), r.episodes, r.goal_rate, to_goal, r.avg_return,
+              r.avg_steps);
   std::printf("outcomes:");
   for (const auto& [status, count] : r.outcomes) {
     std::printf(" %s=%d", status.c_str(), count);
@@ -367,7 +373,8 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--checkpoint", opts->checkpoint,
                   "evaluate the greedy actor of a checkpoint written by pamdp train (its env settings are used, but "
                   "for those a simulator flag given here changes, e.g. --start hfo)")
-      ->check(CLI::ExistingFile);
+      ->check(existing_file("give a checkpoint: models/*.ckpt (trained agents) or RUN_DIR/checkpoint.ckpt or "
+                            "RUN_DIR/best.ckpt of a pamdp train run"));
   cmd->add_option("--env", opts->env,
                   "play on this env instead: " + env_registry().names_joined() +
                       " (--policy scripted plays envs with HFO's actions; others take --checkpoint or --policy "

@@ -148,7 +148,10 @@ void visit(V& v, ExperimentConfig& c) {
 
 class Reader {
  public:
-  Reader(const toml::table& root, std::string source) : root_(root), source_(std::move(source)) {}
+  // `set_by`: the keys that --set gave (dotted, as written) and the assignment that gave each, so
+  // that an error names the command line rather than the file when the bad value came from there.
+  Reader(const toml::table& root, std::string source, std::map<std::string, std::string> set_by)
+      : root_(root), source_(std::move(source)), set_by_(std::move(set_by)) {}
 
   template <typename T>
   void integer(const std::string& key, T& out, int64_t lo, int64_t hi) {
@@ -324,7 +327,7 @@ class Reader {
       for (const auto& name : valid) {
         list += (list.empty() ? "" : ", ") + name;
       }
-      throw std::runtime_error(source_ + ": unknown key '" + key + "' (valid" +
+      throw std::runtime_error(origin(key) + ": unknown key '" + key + "' (valid" +
                                (prefix.empty() ? std::string() : " in [" + prefix + "]") + ": " + list + ")");
     }
   }
@@ -338,11 +341,23 @@ class Reader {
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw std::runtime_error(source_ + ": '" + key + "' " + what);
+    throw std::runtime_error(origin(key) + ": '" + key + "' " + what);
+  }
+
+  // Where `key`'s value came from: "--set key=value" when an override set it (or a table above
+  // it), else the file.
+  [[nodiscard]] std::string origin(const std::string& key) const {
+    for (const auto& [set_key, assignment] : set_by_) {
+      if (key == set_key || key.rfind(set_key + ".", 0) == 0) {
+        return "--set " + assignment;
+      }
+    }
+    return source_;
   }
 
   const toml::table& root_;
   std::string source_;
+  std::map<std::string, std::string> set_by_;
   std::set<std::string> known_;
 };
 
@@ -401,8 +416,8 @@ class Writer {
 };
 
 // Applies "a.b=value": the value is parsed as a TOML value (numbers, true/false, "strings",
-// [arrays]); a bare word that is not valid TOML is taken as a string.
-void apply_override(toml::table& root, const std::string& assignment) {
+// [arrays]); a bare word that is not valid TOML is taken as a string. Returns the dotted key set.
+std::string apply_override(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) {
     throw std::runtime_error("--set '" + assignment + "': expected key=value, e.g. --set ddpg.gamma=0.95");
@@ -435,6 +450,11 @@ void apply_override(toml::table& root, const std::string& assignment) {
     }
   }
   t->insert_or_assign(parts.back(), *parsed.get("v"));
+  std::string dotted;
+  for (const std::string& p : parts) {
+    dotted += (dotted.empty() ? "" : ".") + p;
+  }
+  return dotted;
 }
 
 // The registered envs that give the embedded HFO features, and the setting that makes them
@@ -498,6 +518,14 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              ": exploration.demo_shot aims the scripted offense's shots, and it plays no episodes: "
                              "set exploration.demo_fraction > 0, or leave exploration.demo_shot = \"best-course\"");
   }
+  for (const auto& [key, endpoint] :
+       {std::pair<const char*, const std::string&>{"cluster.learner_bind", c.cluster.learner_bind},
+        {"cluster.weights_bind", c.cluster.weights_bind}}) {
+    if (endpoint.rfind("tcp://", 0) != 0 && endpoint.rfind("ipc://", 0) != 0 && endpoint.rfind("inproc://", 0) != 0) {
+      throw std::runtime_error(src + ": " + key + " '" + endpoint +
+                               "' is not an endpoint: write tcp://HOST:PORT, e.g. tcp://127.0.0.1:5555");
+    }
+  }
 }
 
 }  // namespace
@@ -555,14 +583,17 @@ ExperimentConfig parse_experiment_config(const std::string& toml_text, const std
     ss << source_name << ":" << e.source().begin.line << ": not valid TOML: " << e.description();
     throw std::runtime_error(ss.str());
   }
+  std::map<std::string, std::string> set_by;
+  std::string sets;
   for (const auto& o : overrides) {
-    apply_override(root, o);
+    set_by[apply_override(root, o)] = o;
+    sets += " --set " + o;
   }
   ExperimentConfig c;
-  Reader reader(root, source_name);
+  Reader reader(root, source_name, set_by);
   visit(reader, c);
   reader.reject_unknown();
-  validate(c, source_name);
+  validate(c, overrides.empty() ? source_name : source_name + " with" + sets);
   return c;
 }
 

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,6 +43,9 @@ extern "C" void on_learner_signal(int /*sig*/) {
 using LearnerCliOptions = RunCliOptions;
 
 void run_learner(const LearnerCliOptions& o) {
+  if (o.quiet) {
+    log::quiet();
+  }
   ResolvedRun resolved = resolve_run(o, "learner", "cluster-");
   ExperimentConfig& c = resolved.config;
   const std::string& run_dir = resolved.run_dir;
@@ -114,7 +118,18 @@ void run_learner(const LearnerCliOptions& o) {
     sc.curve_client = keys.client;
     auth = std::make_unique<net::CurveAuthenticator>(ctx, std::vector<std::string>{keys.client.public_key});
   }
-  LearnerServer server(ctx, *algorithm, sc);
+  std::optional<LearnerServer> bound;
+  try {
+    bound.emplace(ctx, *algorithm, sc);
+  } catch (const std::runtime_error& e) {
+    // The socket layer names the endpoint; the user changes it through a config key.
+    const std::string what = e.what();
+    const char* key =
+        what.find("'" + sc.weights_bind + "'") != std::string::npos ? "cluster.weights_bind" : "cluster.learner_bind";
+    throw std::runtime_error("learner: " + what + "; choose another with --set " + key +
+                             "=tcp://127.0.0.1:PORT (port 0: any free port; deploy/local-cluster.sh: --port)");
+  }
+  LearnerServer& server = *bound;
   g_server = &server;
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);

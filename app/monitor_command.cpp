@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
 #include "core/metrics.hpp"
 #include "core/metrics_http.hpp"
@@ -541,7 +542,8 @@ void register_monitor(CLI::App& app) {
   auto o = std::make_shared<MonitorOptions>();
   CLI::App* cmd = app.add_subcommand(
       "monitor", "live view of a cluster's metrics: pamdp monitor --join tcp://LEARNER:PORT, or pamdp monitor URL...");
-  cmd->add_option("--join", o->join, "the learner's join endpoint; it lists every process's metrics URL");
+  cmd->add_option("--join", o->join, "the learner's join endpoint; it lists every process's metrics URL")
+      ->check(zmq_endpoint());
   cmd->add_option("urls", o->urls, "metrics URLs (http://HOST:PORT/metrics), instead of --join");
   cmd->add_option("--curve-keys", o->curve_keys, "directory with client.keys (pamdp keygen), for a CURVE cluster");
   cmd->add_flag("--once", o->once, "print one frame (two scrapes an interval apart) without escape codes and exit");

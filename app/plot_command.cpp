@@ -15,7 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
+#include "app/env_factory.hpp"
+#include "app/experiment_config.hpp"
 
 namespace pamdp::app {
 namespace {
@@ -45,8 +48,23 @@ std::vector<std::string> split_csv_line(const std::string& line) {
 // One run's curves, as columns of numbers (NaN where a cell is empty).
 struct RunCurves {
   std::string label;
-  std::vector<std::vector<double>> columns;  // x, success, return, q, loss, eval success
+  std::vector<std::vector<double>> columns;  // x, success, return, q, loss, eval success (at evaluations only)
+  std::string setup;                         // "env hfo, ddpg, seed 1" from its config.toml; "" if unreadable
+  bool goal = false;                         // its env's success is a goal (GOAL): "goal rate", else "success rate"
 };
+
+// The run's env, learner and seed from its config.toml, and whether its success is a goal.
+void read_setup(const std::string& dir, RunCurves& run) {
+  try {
+    const ExperimentConfig c = load_experiment_config((fs::path(dir) / "config.toml").string(), {});
+    run.setup = "env " + c.env.name + ", " + c.train.algorithm + ", seed " + std::to_string(c.seed);
+    const std::unique_ptr<Env> env = make_env(c.env);
+    run.goal = env->success_status() >= 0 && env->status_name(env->success_status()) == "GOAL";
+  } catch (const std::exception&) {
+    // An older run's config, or an env this build or machine cannot make (an HFO server): the
+    // curves still draw, under a plainer title.
+  }
+}
 
 RunCurves read_run(const std::string& dir, const std::string& x_name) {
   const fs::path csv = fs::path(dir) / "metrics.csv";
@@ -82,6 +100,10 @@ RunCurves read_run(const std::string& dir, const std::string& x_name) {
     run.label = fs::path(dir).lexically_normal().parent_path().filename().string();
   }
   run.columns.resize(index.size());
+  // Every row carries the latest evaluation: a point is drawn where a new one appears (the row
+  // written right after it), not on every row that repeats it.
+  const int eval_return = find("eval_avg_return", false);
+  std::string last_eval;
   while (std::getline(in, line)) {
     const std::vector<std::string> cells = split_csv_line(line);
     for (size_t c = 0; c < index.size(); ++c) {
@@ -92,9 +114,20 @@ RunCurves read_run(const std::string& dir, const std::string& x_name) {
       if (c == 0 && x_name == "hours") {
         v /= 3600.0;
       }
+      if (c == index.size() - 1 && index[c] >= 0) {
+        std::string eval = static_cast<size_t>(index[c]) < cells.size() ? cells[index[c]] : "";
+        if (eval_return >= 0 && static_cast<size_t>(eval_return) < cells.size()) {
+          eval += "," + cells[eval_return];
+        }
+        if (eval == last_eval) {
+          v = NAN;
+        }
+        last_eval = eval;
+      }
       run.columns[c].push_back(v);
     }
   }
+  read_setup(dir, run);
   if (run.columns[0].empty()) {
     throw std::runtime_error("'" + csv.string() + "' has a header but no rows yet: let the run log for a while");
   }
@@ -152,29 +185,51 @@ void run_plot(const PlotOptions& o) {
   }
 
   const std::string x_label = o.x == "hours" ? "wall-clock (hours)" : o.x;
+  // "goal rate" where every run's success is a goal (HFO, goal, platform), else "success rate".
+  bool goal = true;
+  for (const RunCurves& r : runs) {
+    goal = goal && r.goal;
+  }
+  const std::string rate = goal ? "goal rate" : "success rate";
+  // The title: what was trained. One run: its directory, env, learner and seed; several: each.
+  std::string title;
+  for (const RunCurves& r : runs) {
+    title += (title.empty() ? "" : "   |   ") + r.label + (r.setup.empty() ? "" : " (" + r.setup + ")");
+  }
   std::ostringstream g;
   g << "set terminal pngcairo size " << o.width << ',' << o.height << " font 'sans,10' noenhanced\n"
     << "set output " << quoted(out) << "\n"
     << "set datafile missing '?'\n"
-    << "set grid\nset key top left\nset xlabel " << quoted(x_label) << "\n"
-    << "set multiplot layout 2,2\n";
-  auto panel = [&](const std::string& title, int column, const std::string& extra, bool with_eval) {
-    g << "set title " << quoted(title) << "\n" << extra << "plot ";
+    << "set grid\nset xlabel " << quoted(x_label)
+    << "\n"
+    // Episodes, updates and hours all count from the run's start: the axis starts there too,
+    // not where the first metrics row was logged.
+    << "set xrange [0:*]\n"
+    << "set multiplot layout 2,2 title " << quoted(title) << " font 'sans,12'\n";
+  auto panel = [&](const std::string& panel_title, const std::string& y_label, int column, const std::string& extra,
+                   bool with_eval) {
+    // The rate rises from the bottom left to the top right: its legend goes top left, and names
+    // every run's colour for the other panels too, which need none of their own.
+    const std::string key = with_eval ? "set key top left opaque box\n" : "unset key\n";
+    g << "set title " << quoted(panel_title) << "\nset ylabel " << quoted(y_label) << "\n" << key << extra << "plot ";
     for (size_t r = 0; r < runs.size(); ++r) {
       const std::string file = quoted((tmp / ("run" + std::to_string(r) + ".dat")).string());
+      const std::string name = runs.size() == 1 ? std::string("training, last 100 episodes") : runs[r].label;
       g << (r ? ", " : "") << file << " using 1:" << column << " with lines lw 2 lc " << r + 1 << " title "
-        << quoted(runs[r].label);
+        << quoted(name);
       if (with_eval && any_eval) {
-        g << ", " << file << " using 1:6 with points pt 7 ps 0.6 lc " << r + 1 << " notitle";
+        g << ", " << file << " using 1:6 with points pt 7 ps 1.6 lc " << r + 1 << " title "
+          << quoted(runs.size() == 1 ? std::string("greedy evaluation") : runs[r].label + ": greedy evaluation");
       }
     }
     g << "\nunset logscale y\nset autoscale y\n";
   };
-  panel(any_eval ? "goal rate (lines: last 100 episodes; points: greedy evaluations)" : "goal rate (last 100 episodes)",
-        2, "set yrange [0:1.05]\n", true);
-  panel("mean episode return (last 100)", 3, "", false);
-  panel("mean Q (sampled batch)", 4, "", false);
-  panel("critic loss", 5, "set logscale y\nset format y '%g'\n", false);
+  panel(rate + (any_eval ? " (lines: last 100 training episodes; points: greedy evaluations)"
+                         : " (last 100 training episodes)"),
+        rate, 2, "set yrange [0:1.05]\n", true);
+  panel("mean episode return (last 100 episodes)", "return", 3, "", false);
+  panel("mean Q (sampled batch)", "Q", 4, "", false);
+  panel("critic loss", "loss", 5, "set logscale y\nset format y '%g'\n", false);
   g << "unset multiplot\n";
   const fs::path script = tmp / "plot.gp";
   std::ofstream(script) << g.str();
@@ -195,7 +250,8 @@ void register_plot(CLI::App& app) {
       "plot", "draw learning curves (goal rate, return, mean Q, critic loss) of run directories into a PNG");
   cmd->add_option("runs", o->runs, "run directories (written by pamdp train or pamdp learner); several are overlaid")
       ->required()
-      ->check(CLI::ExistingDirectory);
+      ->check(existing_directory("give the run directory of a pamdp train or pamdp learner run (runs/... by "
+                                 "default; it holds metrics.csv)"));
   cmd->add_option("--out", o->out, "PNG to write (default RUN_DIR/curves.png for one run, ./curves.png for several)");
   cmd->add_option("--x", o->x, "x axis")->check(CLI::IsMember({"episodes", "updates", "hours"}))->capture_default_str();
   cmd->add_option("--width", o->width, "image width in pixels")->check(CLI::Range(200, 10000))->capture_default_str();

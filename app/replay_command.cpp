@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
 #include "app/env_factory.hpp"
 #include "app/network_security.hpp"
@@ -159,14 +160,18 @@ void register_replay(CLI::App& app) {
   auto o = std::make_shared<ReplayCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "replay", "run one replay shard: joins the learner, stores actors' transitions, serves the learner's samples");
-  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")->required();
+  cmd->add_option("--join", o->join, "the learner's join endpoint, e.g. tcp://LEARNER:5555")
+      ->required()
+      ->check(zmq_endpoint());
   cmd->add_option(
          "--insert-bind", o->insert_bind,
          "where actors insert (ROUTER); port 0 = any free port; beyond loopback needs --curve-keys or --insecure")
+      ->check(zmq_endpoint())
       ->capture_default_str();
   cmd->add_option(
          "--sample-bind", o->sample_bind,
          "where the learner samples (ROUTER); port 0 = any free port; beyond loopback needs --curve-keys or --insecure")
+      ->check(zmq_endpoint())
       ->capture_default_str();
   cmd->add_option("--advertise-host", o->advertise_host, "the host name peers use to reach this machine's ports")
       ->capture_default_str();

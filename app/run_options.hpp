@@ -89,7 +89,9 @@ inline void add_run_options(CLI::App& cmd, RunCliOptions& o, const RunOptionHelp
   cmd.add_option("--seed", o.seed, "random seed (overrides the config's seed)")->check(CLI::NonNegativeNumber);
   cmd.add_option("--run-dir", o.run_dir, help.run_dir);
   cmd.add_option("--resume", o.resume, "continue the run in this directory from its checkpoint");
-  cmd.add_flag("--quiet", o.quiet, "no progress lines");
+  cmd.add_flag("--quiet", o.quiet,
+               "no progress lines and no [info] log lines (warnings and errors still print; an explicit --log-level "
+               "wins)");
   cmd.add_option("--metrics-bind", o.metrics_bind, "address to serve /metrics on (overrides metrics.bind)");
   cmd.add_option("--metrics-port", o.metrics_port, "port of /metrics, 0 = any free port (overrides metrics.port)")
       ->check(CLI::Range(0, 65535));

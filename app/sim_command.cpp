@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_checks.hpp"
 #include "app/commands.hpp"
 #include "app/sim_options.hpp"
 #include "envs/hfo/goalie.hpp"
@@ -116,12 +117,12 @@ void register_sim(CLI::App& app) {
           "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}, "
           "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch, tackle_cycles, caught}}")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file("give a STATE.json (an example: tests/golden/kick_to_goal.state.json)"));
   trace
       ->add_option("--actions", opts->actions,
                    "ACTIONS.csv: rows DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file("give an ACTIONS.csv (an example: tests/golden/kick_to_goal.actions.csv)"));
   trace->add_option("--seed", opts->seed, "seed of the noise stream")->capture_default_str();
   opts->sim.add_to(*trace);
   trace->callback([opts] { run_trace(*opts); });

@@ -16,6 +16,7 @@
 #include "app/run_options.hpp"
 #include "app/run_support.hpp"
 #include "app/trainer.hpp"
+#include "core/log.hpp"
 
 namespace pamdp::app {
 namespace {
@@ -32,6 +33,9 @@ struct TrainCliOptions : RunCliOptions {
 
 void run_train(const TrainCliOptions& o) {
   namespace fs = std::filesystem;
+  if (o.quiet) {
+    log::quiet();
+  }
   ResolvedRun run = resolve_run(o, "train", "");
   ExperimentConfig& config = run.config;
   TrainOptions opts;
@@ -54,11 +58,16 @@ void run_train(const TrainCliOptions& o) {
     std::fflush(stdout);
   }
   const TrainSummary s = train(config, opts);
+  // Steps to success only when some episode succeeded: an average over none is not 0.
+  char to_success[64] = "";
+  if (s.final_eval.goal_rate > 0.0) {
+    std::snprintf(to_success, sizeof(to_success), ", avg steps to success %.1f", s.final_eval.avg_steps_to_goal);
+  }
   std::printf(
-      "done: %lld updates, %lld episodes, %lld env steps in %.1f s; greedy eval %d episodes: success %.3f, "
-      "avg steps to success %.1f, return %.3f; checkpoint %s/checkpoint.ckpt\n",
+      "done: %lld updates, %lld episodes, %lld env steps in %.1f s; greedy eval %d episodes: success %.3f%s, "
+      "return %.3f; checkpoint %s/checkpoint.ckpt\n",
       static_cast<long long>(s.updates), static_cast<long long>(s.episodes), static_cast<long long>(s.env_steps),
-      s.seconds, s.final_eval.episodes, s.final_eval.goal_rate, s.final_eval.avg_steps_to_goal, s.final_eval.avg_return,
+      s.seconds, s.final_eval.episodes, s.final_eval.goal_rate, to_success, s.final_eval.avg_return,
       opts.run_dir.c_str());
   if (o.json) {
     std::printf(

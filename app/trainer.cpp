@@ -173,6 +173,28 @@ TrainSummary Trainer::run() {
   };
   // best.ckpt played again (train.recheck_best): the run's own learner, its weights from the file.
   run_.make_incumbent = [this] { return make_learner(c_, obs_dim_, space_, c_.seed, UpdateDevice::kCpu); };
+  if (o_.resume) {
+    // The replay snapshots first: one that does not fit this run's memory is refused before
+    // start() touches the run directory (a resume that changed the config rewrites config.toml).
+    const auto restore = [](const fs::path& file, ReplayBuffer& buffer) {
+      try {
+        load_replay_snapshot(file.string(), buffer);
+      } catch (const std::runtime_error& e) {
+        // The memory's shape comes from replay.capacity and the env: only a --set can change them.
+        if (std::string(e.what()).find("was written for capacity") == std::string::npos) {
+          throw;
+        }
+        throw std::runtime_error(std::string(e.what()) +
+                                 "; a resumed run keeps the replay.capacity and env settings it began with: resume "
+                                 "without the --set that changed them (config.toml has the run's own), or start a "
+                                 "new run with another --run-dir");
+      }
+    };
+    restore(dir / "replay.bin", replay_);
+    if (demo_replay_) {
+      restore(dir / "demo_replay.bin", *demo_replay_);
+    }
+  }
   const CheckpointMeta meta = run_.start(o_.resume);
   if (o_.resume) {
     const std::string ck = (dir / "checkpoint.ckpt").string();
@@ -183,10 +205,6 @@ TrainSummary Trainer::run() {
     explore_.rng().set_state(meta.rng_states[0]);
     sample_rng_.set_state(meta.rng_states[1]);
     update_credit_ = meta.update_credit;
-    load_replay_snapshot((dir / "replay.bin").string(), replay_);
-    if (demo_replay_) {
-      load_replay_snapshot((dir / "demo_replay.bin").string(), *demo_replay_);
-    }
   }
   if (!o_.quiet) {
     bar_.emplace("updates", c_.train.max_updates);
@@ -209,9 +227,11 @@ TrainSummary Trainer::run() {
       }
 
       update_credit_ += c_.train.updates_per_step;
-      // Limits are checked at episode ends only (see should_stop), so a run stopped at N updates
-      // and resumed passes through exactly the states of a run that never stopped.
-      while (update_credit_ >= 1.0 && run_.update(*sampler_)) {
+      // Limits are checked at episode ends only (see should_stop), so a run stopped by a signal,
+      // train.max_seconds or train.max_episodes and resumed passes through exactly the states of
+      // a run that never stopped. train.max_updates is a count, not a time: no update past it,
+      // while the episode it falls in plays to its end.
+      while (update_credit_ >= 1.0 && algorithm_->updates() < c_.train.max_updates && run_.update(*sampler_)) {
         if (o_.metrics != nullptr) {
           o_.metrics->on_update(run_.last_update(), algorithm_->updates(), c_.ddpg.batch_size);
         }
@@ -254,11 +274,15 @@ TrainSummary Trainer::run() {
     bar_->finish();
   }
   TrainSummary s;
-  run_.evaluate();
+  // The final evaluation, unless the loop's last episode ended with one at this very update
+  // (and its row): a second would repeat it, and its row would read 0 updates/s.
+  if (!run_.last_eval() || run_.last_eval_updates() != algorithm_->updates()) {
+    run_.evaluate();
+    log_tick(true);
+  }
   if (run_.last_eval()) {
     s.final_eval = *run_.last_eval();
   }
-  log_tick(true);
   s.updates = algorithm_->updates();
   s.env_steps = run_.env_steps();
   s.episodes = run_.episodes();

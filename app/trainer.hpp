@@ -6,8 +6,10 @@
 // at episode boundaries every train.checkpoint_every_seconds and at the end). Resuming from
 // it continues bit for bit: env episodes are seeded from (seed, episode index), every random
 // stream is in the checkpoint, and stop conditions are checked only at episode boundaries
-// (so a run ends at the first episode end after a limit: max_updates may be exceeded by less
-// than one episode's updates).
+// (a run ends at the first episode end after a limit). train.max_updates is exact: no update
+// past it, the episode it falls in played to its end without updates; so a run stopped by
+// max_updates and resumed with a higher one is not bit for bit a run that never stopped (one
+// stopped by a signal, max_seconds or max_episodes is).
 #pragma once
 
 #include <atomic>

@@ -17,4 +17,8 @@ using spdlog::warn;
 // Returns false and changes nothing if the name is unknown.
 bool set_level(std::string_view name);
 
+// What --quiet asks of the log: warnings and errors only, unless a level was chosen with
+// set_level (an explicit --log-level wins). Start-up only; not thread-safe with set_level.
+void quiet();
+
 }  // namespace pamdp::log

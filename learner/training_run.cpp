@@ -188,6 +188,7 @@ void TrainingRun::evaluate() {
   GreedyActorPolicy policy(algorithm_, eval_env_.action_space(), spec_.exploration, algorithm_.evaluated_copy());
   const int64_t at = algorithm_.updates();
   last_eval_ = pamdp::evaluate(eval_env_, policy, loop.eval_episodes, screening_seed(spec_.seed, at));
+  last_eval_updates_ = at;
   log::info("{}: greedy evaluation at {} updates: success {:.3f} over {} episodes, return {:.3f}", spec_.role, at,
             last_eval_->goal_rate, last_eval_->episodes, last_eval_->avg_return);
   if (on_eval) {

@@ -169,6 +169,8 @@ class TrainingRun {
   [[nodiscard]] const RecentEpisodes& recent() const { return recent_; }
   [[nodiscard]] const UpdateStats& last_update() const { return last_stats_; }
   [[nodiscard]] const std::optional<EvalResult>& last_eval() const { return last_eval_; }
+  // The update count last_eval() was played at; -1 before the first.
+  [[nodiscard]] int64_t last_eval_updates() const { return last_eval_updates_; }
   // The ε of the schedule at the current update.
   [[nodiscard]] double epsilon() const;
   [[nodiscard]] const RunSpec& spec() const { return spec_; }
@@ -190,6 +192,7 @@ class TrainingRun {
   RecentEpisodes recent_;
   UpdateStats last_stats_;
   std::optional<EvalResult> last_eval_;
+  int64_t last_eval_updates_ = -1;
   int64_t episodes_ = 0;
   int64_t env_steps_ = 0;
   int64_t next_eval_ = INT64_MAX;

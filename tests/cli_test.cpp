@@ -1,7 +1,10 @@
 // The `pamdp` executable as a user meets it: help, `eval --json`, flag errors, and
 // `sim trace` against a golden trace (tests/golden; refresh with tests/golden/regenerate.sh
 // after an intended physics change).
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,12 +36,14 @@ struct RunResult {
   std::string output;
 };
 
-enum class Capture { kStdoutAndStderr, kStdoutOnly };
+enum class Capture { kStdoutAndStderr, kStdoutOnly, kStderrOnly };
 
 // Runs `pamdp <args>` through the shell and collects its output and exit status.
 RunResult run_pamdp(const std::string& args, Capture capture = Capture::kStdoutAndStderr) {
-  const std::string cmd =
-      "'" + kPamdp + "' " + args + (capture == Capture::kStdoutAndStderr ? " 2>&1" : " 2>/dev/null");
+  const char* redirect = capture == Capture::kStdoutAndStderr ? " 2>&1"
+                         : capture == Capture::kStdoutOnly    ? " 2>/dev/null"
+                                                              : " 2>&1 >/dev/null";
+  const std::string cmd = "'" + kPamdp + "' " + args + redirect;
   RunResult r;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (pipe == nullptr) {
@@ -624,5 +629,191 @@ INSTANTIATE_TEST_SUITE_P(
         MalformedInput{"ActionsWrongArity", false, "DASH,100,0\n\nTURN,10\nKICK,100\n", {":4:", "KICK,power,dir"}},
         MalformedInput{"ActionsNotANumber", false, "DASH,fast,0\n", {":1:", "fast"}}),
     [](const ::testing::TestParamInfo<MalformedInput>& info) { return info.param.name; });
+
+// Every error a user can cause (issue 81): exit status 2 (pamdp --help's "Exit status") and one
+// line on stderr, `pamdp: error: …`, that names the problem and the fix, with no usage text.
+struct UserError {
+  std::string name;
+  std::string args;
+  std::vector<std::string> message_names;  // substrings the line must contain
+  std::vector<std::string> absent = {};    // substrings it must not (a misleading diagnosis)
+};
+
+void PrintTo(const UserError& c, std::ostream* os) {
+  *os << c.name;
+}
+
+// `pamdp <args>` with its stderr only.
+RunResult run_pamdp_stderr(const std::string& args) {
+  return run_pamdp(args, Capture::kStderrOnly);
+}
+
+void expect_one_error_line(const RunResult& r, const std::vector<std::string>& names,
+                           const std::vector<std::string>& absent = {}) {
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  std::vector<std::string> lines;
+  for (const std::string& line : split(r.output, '\n')) {
+    if (!line.empty()) {
+      lines.push_back(line);
+    }
+  }
+  ASSERT_EQ(lines.size(), 1U) << "stderr is not one line:\n" << r.output;
+  EXPECT_EQ(lines[0].rfind("pamdp: error: ", 0), 0U) << lines[0];
+  for (const std::string& s : names) {
+    EXPECT_NE(lines[0].find(s), std::string::npos) << "the line does not name '" << s << "':\n" << lines[0];
+  }
+  for (const std::string& s : absent) {
+    EXPECT_EQ(lines[0].find(s), std::string::npos) << "the line names '" << s << "':\n" << lines[0];
+  }
+}
+
+class CliUserErrors : public ::testing::TestWithParam<UserError> {};
+
+TEST_P(CliUserErrors, OneLineNamingTheFixAndExitTwo) {
+  const RunResult r = run_pamdp_stderr(GetParam().args);
+  expect_one_error_line(r, GetParam().message_names, GetParam().absent);
+}
+
+const std::string kReachStop = quoted(PAMDP_SOURCE_DIR "/deploy/configs/reach_stop.toml");
+const std::string kUnusedRun = quoted(::testing::TempDir() + "pamdp_cli_unused_run");
+
+INSTANTIATE_TEST_SUITE_P(
+    Issue81, CliUserErrors,
+    ::testing::Values(
+        UserError{
+            "EpisodesOutOfRange", "eval --episodes -1", {"--episodes", "[1, 100000000]", "got -1", "eval --help"}},
+        UserError{"MissingCheckpoint",
+                  "eval --checkpoint /nonexistent/agent.ckpt",
+                  {"--checkpoint", "/nonexistent/agent.ckpt", "models/*.ckpt"}},
+        UserError{"PlotMissingDirectory", "plot /nonexistent/run", {"/nonexistent/run", "run directory"}},
+        UserError{"JoinWithoutScheme",
+                  "actor --join 127.0.0.1:5999",
+                  {"--join", "tcp://127.0.0.1:5999"},
+                  {"CURVE", "beyond"}},
+        UserError{"ReplayJoinWithoutScheme", "replay --join 127.0.0.1:5999", {"--join", "tcp://127.0.0.1:5999"}},
+        UserError{"SetNamesTheCommandLine",
+                  "train --config " + kReachStop + " --set ddpg.gamma=2 --run-dir " + kUnusedRun,
+                  {"--set ddpg.gamma=2", "[0, 1]"},
+                  {"reach_stop.toml"}},
+        UserError{"SetUnknownKeyNamesTheCommandLine",
+                  "train --config " + kReachStop + " --set ddpg.gama=0.9 --run-dir " + kUnusedRun,
+                  {"--set ddpg.gama=0.9", "gamma"},
+                  {"reach_stop.toml"}},
+        UserError{
+            "LearnerBindWithoutScheme",
+            "learner --config " + kReachStop + " --set cluster.learner_bind=127.0.0.1:5555 --run-dir " + kUnusedRun,
+            {"cluster.learner_bind", "tcp://"},
+            {"CURVE"}},
+        UserError{"LogLevelUnknown", "train --log-level loud", {"--log-level", "loud"}},
+        UserError{"UnknownFlag", "eval --no-such-flag", {"--no-such-flag", "pamdp eval --help"}},
+        UserError{"NoSubcommand", "", {"valid: actor", "eval", "train"}},
+        UserError{"SimWithoutSubcommand", "sim", {"pamdp sim", "trace"}},
+        UserError{"UnknownSubcommand", "frobnicate", {"frobnicate", "valid:"}},
+        UserError{"MissingTraceState",
+                  "sim trace --init /nonexistent/state.json --actions /nonexistent/a.csv",
+                  {"--init", "/nonexistent/state.json"}},
+        UserError{"ResumeWithoutARun", "train --resume /nonexistent/run", {"/nonexistent/run", "--resume"}}),
+    [](const ::testing::TestParamInfo<UserError>& info) { return info.param.name; });
+
+// A run directory under the test temp dir, removed when the test ends.
+class TempRun {
+ public:
+  explicit TempRun(const std::string& name)
+      : path_(::testing::TempDir() + "pamdp_cli_" + name + "_" + std::to_string(::getpid())) {
+    std::filesystem::remove_all(path_);
+  }
+  ~TempRun() { std::filesystem::remove_all(path_); }
+  TempRun(const TempRun&) = delete;
+  TempRun& operator=(const TempRun&) = delete;
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// A learner whose join port is taken names the key that moves it.
+TEST(CliUserErrors, PortInUseNamesTheConfigKey) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
+  ASSERT_EQ(::listen(fd, 1), 0);
+  socklen_t len = sizeof(addr);
+  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  const std::string port = std::to_string(ntohs(addr.sin_port));
+  const TempRun run("busy");
+  const RunResult r = run_pamdp_stderr("learner --config " + kReachStop + " --run-dir " + quoted(run.path()) +
+                                       " --set cluster.learner_bind=tcp://127.0.0.1:" + port +
+                                       " --set cluster.weights_bind=tcp://127.0.0.1:0 --metrics-port 0");
+  ::close(fd);
+  expect_one_error_line(r, {port, "in use", "--set cluster.learner_bind=tcp://127.0.0.1:PORT"});
+}
+
+// A tiny run of the toy task (seconds), for the tests below.
+const std::string kTinyRun =
+    " --set train.max_updates=300 --set replay.warmup=100 --set train.eval_every_updates=0 "
+    "--set train.eval_episodes=5 --set ddpg.hidden=[16,16]";
+
+// --resume with a replay memory of another shape (replay.capacity changed by --set) names the fix.
+TEST(CliUserErrors, ResumeWithAnotherReplayShapeNamesTheFix) {
+  const TempRun run("reshape");
+  const RunResult made =
+      run_pamdp("train --quiet --config " + kReachStop + kTinyRun + " --run-dir " + quoted(run.path()));
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const std::string config = read_text(run.path() + "/config.toml");
+  const RunResult r = run_pamdp_stderr("train --resume " + quoted(run.path()) + " --set replay.capacity=5000");
+  expect_one_error_line(r, {"replay.bin", "replay.capacity", "without the --set"});
+  // Refused before the run directory is touched: the fix it names (resume without the --set) works.
+  EXPECT_EQ(read_text(run.path() + "/config.toml"), config);
+  const RunResult resumed = run_pamdp("train --quiet --resume " + quoted(run.path()) + " --set train.max_updates=400");
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+}
+
+// --log-level comes after `train` as after `actor`; --quiet drops the [info] lines, an explicit
+// --log-level wins over it, and a plain run has them (so the checks below can fail).
+TEST(CliUserErrors, LogLevelAfterTrainAndQuiet) {
+  const auto train = [](const std::string& name, const std::string& flags) {
+    const TempRun run(name);
+    return run_pamdp("train --config " + kReachStop + kTinyRun + " --run-dir " + quoted(run.path()) + " " + flags);
+  };
+  const RunResult plain = train("plain", "");
+  const RunResult warn = train("warn", "--log-level warn");
+  const RunResult quiet = train("quiet", "--quiet");
+  const RunResult quiet_debug = train("quiet_debug", "--quiet --log-level debug");
+  for (const RunResult* r : {&plain, &warn, &quiet, &quiet_debug}) {
+    ASSERT_EQ(r->exit_code, 0) << r->output;
+    EXPECT_NE(r->output.find("done: 300 updates"), std::string::npos) << r->output;
+  }
+  EXPECT_NE(plain.output.find("[info]"), std::string::npos) << plain.output;
+  EXPECT_EQ(warn.output.find("[info]"), std::string::npos) << warn.output;
+  EXPECT_EQ(quiet.output.find("[info]"), std::string::npos) << quiet.output;
+  EXPECT_EQ(quiet.output.find("updates/s"), std::string::npos) << "--quiet printed progress lines:\n" << quiet.output;
+  EXPECT_NE(quiet_debug.output.find("[info]"), std::string::npos) << quiet_debug.output;
+}
+
+// The toy run's summary (issue 81): it stops at exactly train.max_updates, logs its final
+// evaluation once, and says nothing of steps to success when nothing succeeded.
+TEST(CliUserErrors, ToyRunSummary) {
+  const TempRun run("toy");
+  const RunResult r = run_pamdp("train --config " + kReachStop + " --run-dir " + quoted(run.path()) +
+                                " --set train.max_updates=2000 --set train.eval_every_updates=1000 "
+                                "--set train.eval_episodes=20 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("done: 2000 updates"), std::string::npos) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(last_line(r.output));
+  EXPECT_EQ(j["updates"], 2000);
+  int at_end = 0;
+  int rows_at_end = 0;
+  for (const std::string& line : split(r.output, '\n')) {
+    at_end += line.find("greedy evaluation at 2000 updates") != std::string::npos ? 1 : 0;
+    rows_at_end += line.find("] updates 2000 |") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(at_end, 1) << r.output;
+  EXPECT_EQ(rows_at_end, 1) << r.output;
+  const double success = j["eval"]["goal_rate"];
+  EXPECT_EQ(r.output.find("avg steps to success") != std::string::npos, success > 0.0) << r.output;
+}
 
 }  // namespace

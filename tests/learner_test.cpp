@@ -933,13 +933,31 @@ TEST(Train, WithTheShootActionTheTeachersShotsAreClonedAsShoot) {
   fs::remove_all(dir);
 }
 
+// The episodes a run finished before its updates reached `updates` (from its episodes.csv): a
+// train.max_episodes that stops a run at an episode end just before that point.
+int64_t episodes_before(const fs::path& dir, int64_t updates) {
+  int64_t n = 0;
+  for (const EpisodeCsvRow& r : episode_rows(dir / "episodes.csv")) {
+    n += r.updates < updates ? 1 : 0;
+  }
+  return n;
+}
+
+// Stopped by train.max_episodes (as a long run is extended: --set train.max_episodes=N) and
+// resumed, a run ends where one that never stopped does. train.max_updates is exact: both stop
+// at 3,000 updates, not at the end of the episode past it.
 TEST(Train, ResumeIsBitForBit) {
   const fs::path a = fresh_dir("straight");
   const fs::path b = fresh_dir("halves");
   const app::ExperimentConfig full = toy_config(3000);
-  app::train(full, {a.string(), false, true, nullptr});
-  app::train(toy_config(1950), {b.string(), false, true, nullptr});
-  app::train(full, {b.string(), true, true, nullptr});
+  const app::TrainSummary straight_summary = app::train(full, {a.string(), false, true, nullptr});
+  EXPECT_EQ(straight_summary.updates, 3000);
+  app::ExperimentConfig half = full;
+  half.train.max_episodes = episodes_before(a, 1950);
+  const app::TrainSummary first = app::train(half, {b.string(), false, true, nullptr});
+  ASSERT_LT(first.updates, 2000) << "the first half must stop before the evaluation at 2,000 updates";
+  const app::TrainSummary second = app::train(full, {b.string(), true, true, nullptr});
+  EXPECT_EQ(second.updates, 3000);
   EXPECT_EQ(read_file_bytes((a / "replay.bin").string()), read_file_bytes((b / "replay.bin").string()));
   EXPECT_EQ(params_of((a / "checkpoint.ckpt").string(), full), params_of((b / "checkpoint.ckpt").string(), full));
   // The last-100 training rates go on across the resume: the rows both runs wrote at the same
@@ -961,7 +979,7 @@ TEST(Train, ResumeIsBitForBit) {
   int compared = 0;
   for (const auto& [updates, row] : halves) {
     const auto it = straight.find(updates);
-    if (updates == "updates" || it == straight.end() || std::stoll(updates) <= 1950) {
+    if (updates == "updates" || it == straight.end() || std::stoll(updates) <= first.updates) {
       continue;
     }
     ++compared;
@@ -1121,7 +1139,9 @@ TEST(Train, ActorAverageSurvivesAResume) {
     return c;
   };
   app::train(config(3000), {a.string(), false, true, nullptr});
-  app::train(config(1950), {b.string(), false, true, nullptr});
+  app::ExperimentConfig half = config(3000);
+  half.train.max_episodes = episodes_before(a, 1950);
+  app::train(half, {b.string(), false, true, nullptr});
   app::train(config(3000), {b.string(), true, true, nullptr});
   const auto average_of = [](const fs::path& ckpt, const app::ExperimentConfig& c) {
     toy::ReachStopEnv env;

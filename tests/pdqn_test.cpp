@@ -463,8 +463,13 @@ TEST(Pdqn, LearnsReachStopAndResumesExactly) {
 
     const fs::path straight = fresh_dir(algorithm + "_straight");
     const fs::path halves = fresh_dir(algorithm + "_halves");
-    app::train(toy(algorithm, 3000), {straight.string(), false, true, nullptr});
-    app::train(toy(algorithm, 1950), {halves.string(), false, true, nullptr});
+    // Stopped half-way by train.max_episodes (train.max_updates is exact, so a run it stops ends
+    // its last episode without updates, which one that never stopped makes).
+    const app::TrainSummary whole = app::train(toy(algorithm, 3000), {straight.string(), false, true, nullptr});
+    EXPECT_EQ(whole.updates, 3000) << algorithm;
+    app::ExperimentConfig half = toy(algorithm, 3000);
+    half.train.max_episodes = whole.episodes / 2;
+    app::train(half, {halves.string(), false, true, nullptr});
     app::train(toy(algorithm, 3000), {halves.string(), true, true, nullptr});
     EXPECT_EQ(state_of(straight / "checkpoint.ckpt", toy(algorithm, 3000)),
               state_of(halves / "checkpoint.ckpt", toy(algorithm, 3000)))
@@ -792,8 +797,10 @@ TEST(Pdqn, EvaluationAverageSurvivesAResume) {
   };
   const fs::path straight = fresh_dir("avg_straight");
   const fs::path halves = fresh_dir("avg_halves");
-  app::train(config(3000), {straight.string(), false, true, nullptr});
-  app::train(config(1950), {halves.string(), false, true, nullptr});
+  const app::TrainSummary whole = app::train(config(3000), {straight.string(), false, true, nullptr});
+  app::ExperimentConfig half = config(3000);
+  half.train.max_episodes = whole.episodes / 2;
+  app::train(half, {halves.string(), false, true, nullptr});
   app::train(config(3000), {halves.string(), true, true, nullptr});
   EXPECT_EQ(state_of(straight / "checkpoint.ckpt", config(3000)), state_of(halves / "checkpoint.ckpt", config(3000)));
   const toy::ReachStopEnv env;
