@@ -239,7 +239,9 @@ void run_plot(const PlotOptions& o) {
     throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + ") writing '" + out +
                              "': check that the directory exists and is writable");
   }
-  std::printf("wrote %s (%zu run%s)\n", out.c_str(), runs.size(), runs.size() == 1 ? "" : "s");
+  // What the picture says, for a reader of the terminal and for tests: its title and its rate.
+  std::printf("wrote %s (%zu run%s): %s; %s%s\n", out.c_str(), runs.size(), runs.size() == 1 ? "" : "s", title.c_str(),
+              rate.c_str(), any_eval ? " with greedy evaluations" : "");
 }
 
 }  // namespace

@@ -529,10 +529,18 @@ TEST(Plot, DrawsTheCurvesOfARealRun) {
   in.read(magic, 8);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "not a PNG: " << png;
   EXPECT_GT(fs::file_size(png), 10000U);
+  // Its title names the run's env, learner and seed; the toy task has no goal, so its rate is a
+  // success rate; its evaluations are drawn (issue 81).
+  EXPECT_NE(out.find("toy (env reach_stop, ddpg, seed 1)"), std::string::npos) << out;
+  EXPECT_NE(out.find("; success rate with greedy evaluations"), std::string::npos) << out;
+  EXPECT_EQ(out.find("goal rate"), std::string::npos) << out;
 
   out.clear();
   EXPECT_NE(run("'" + pamdp + "' plot '" + dir.string() + "'", &out), 0);  // not a run directory
   EXPECT_NE(out.find("no metrics.csv"), std::string::npos) << out;
+  out.clear();
+  EXPECT_EQ(run("'" + pamdp + "' plot '" + (dir / "nowhere").string() + "'", &out), 2);  // no such directory
+  EXPECT_NE(out.find("pamdp: error: runs: no directory"), std::string::npos) << out;
   fs::remove_all(dir);
 }
 
