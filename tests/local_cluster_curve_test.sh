@@ -41,6 +41,10 @@ refused=$(curl -sf --max-time 2 "$lurl" | awk '$1 == "pamdp_connections_refused_
 [[ $refused =~ ^[0-9]+$ ]] && ((refused >= 1)) || fail "the learner counted no refused connection (got '$refused')"
 
 wait "$script" || fail "local-cluster.sh exited with an error"
+# The learner's final line reaches the terminal, not only its log, once (issue 81).
+n_final=$(grep -c "^learner stopped: [0-9]* updates" "$work/out.log" || true)
+[[ $n_final == 1 ]] || fail "local-cluster.sh printed the learner's final line $n_final times, not once"
+grep -q "HFO takes tens of minutes" "$work/out.log" && fail "local-cluster.sh said HFO takes minutes on the toy task"
 for f in server.keys client.keys; do
   [[ -f $work/run/keys/$f ]] || fail "no $f in the run directory's keys"
   mode=$(stat -c %a "$work/run/keys/$f")
