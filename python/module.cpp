@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "learner/ddpg.hpp"
 #include "learner/greedy_policy.hpp"
 #include "python/env_registry.hpp"
+#include "python/field_text.hpp"
 #include "python/vector_env.hpp"
 
 namespace py = pybind11;
@@ -37,6 +39,12 @@ std::string type_name(py::handle h) {
   return py::str(py::type::handle_of(h).attr("__name__"));
 }
 
+// info["outcome"]: the env's name for a status, with one word for an episode that goes on
+// (status 0) in every env: HFO's "IN_GAME" (the toy envs' C++ name is "IN_PROGRESS").
+std::string outcome_name(const Env& env, int status) {
+  return status == 0 ? std::string("IN_GAME") : std::string(env.status_name(status));
+}
+
 // What every binding needs to know about an env's statuses and actions, read once.
 struct EnvFacts {
   explicit EnvFacts(const Env& env) : space(env.action_space()), obs_size(env.observation_size()) {
@@ -46,7 +54,7 @@ struct EnvFacts {
     }
     status_names.resize(static_cast<size_t>(top) + 1);
     for (int s : env.outcomes()) {
-      status_names[static_cast<size_t>(s)] = py::str(std::string(env.status_name(s)));
+      status_names[static_cast<size_t>(s)] = py::str(outcome_name(env, s));
       if (env.status_name(s) == "OUT_OF_TIME") {
         timeout_status = s;
       }
@@ -259,7 +267,7 @@ py::list describe_actions(const ActionSpace& space) {
 py::list describe_outcomes(const Env& env) {
   py::list out;
   for (int s : env.outcomes()) {
-    out.append(py::make_tuple(s, std::string(env.status_name(s))));
+    out.append(py::make_tuple(s, outcome_name(env, s)));
   }
   return out;
 }
@@ -287,6 +295,8 @@ class PyEnv {
       env_->reset(s, out);
     }
     needs_reset_ = false;
+    steps_ = 0;
+    last_status_ = 0;
     return py::make_tuple(std::move(obs), info(0));
   }
 
@@ -296,19 +306,54 @@ class PyEnv {
                              ": step() before reset() or after the episode ended; call reset() first");
     }
     const int id = read_action(action, facts_, shared_);
+    if (!warned_out_of_bounds_) {
+      warn_out_of_bounds(id);
+    }
     py::array_t<float> obs(facts_.obs_size);
     const StepResult r =
         env_->step({id, shared_}, std::span<float>(obs.mutable_data(), static_cast<size_t>(facts_.obs_size)));
     const bool timeout = r.status == facts_.timeout_status;
     needs_reset_ = r.terminal();
+    ++steps_;
+    last_status_ = r.status;
     return py::make_tuple(std::move(obs), static_cast<double>(r.reward), r.terminal() && !timeout, timeout,
                           info(r.status));
   }
 
   [[nodiscard]] const Env& env() const { return *env_; }
   [[nodiscard]] const app::EnvConfig& config() const { return config_; }
+  // render("ansi"): the field as text (python/field_text.hpp).
+  [[nodiscard]] std::string render_text() { return field_text(*env_, last_status_, steps_); }
 
  private:
+  // The rule for a parameter outside action_space's bounds is the env's own, the real HFO's:
+  // it is clamped to the range the env accepts (HFO: powers to the server's range, directions
+  // to [-180, 180]), never refused. Said once per env, as a Python warning.
+  void warn_out_of_bounds(int id) {
+    for (int i : facts_.space.actions[static_cast<size_t>(id)].param_indices) {
+      const ParamSpec& p = facts_.space.params[static_cast<size_t>(i)];
+      const float v = shared_[static_cast<size_t>(i)];
+      if (v >= p.lo && v <= p.hi) {
+        continue;
+      }
+      warned_out_of_bounds_ = true;
+      const auto num = [](float x) {
+        char text[32];
+        std::snprintf(text, sizeof(text), "%g", static_cast<double>(x));
+        return std::string(text);
+      };
+      const std::string text =
+          std::string(env_->name()) + ": " + facts_.space.actions[static_cast<size_t>(id)].name + " parameter " +
+          p.name + " = " + num(v) + " is outside action_space's bounds [" + num(p.lo) + ", " + num(p.hi) +
+          "]; the env clamps out-of-range parameters to the range it accepts, as the real HFO does (wrap the env in "
+          "gymnasium.wrappers.ClipAction to clip to these bounds instead). Warned once per env.";
+      if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) {
+        throw py::error_already_set();  // warnings turned into errors (python -W error)
+      }
+      return;
+    }
+  }
+
   [[nodiscard]] py::dict info(int status) const {
     py::dict d;
     d["outcome"] = facts_.status_names[static_cast<size_t>(status)];
@@ -321,6 +366,9 @@ class PyEnv {
   EnvFacts facts_;
   std::vector<float> shared_;
   bool needs_reset_ = true;
+  bool warned_out_of_bounds_ = false;
+  int steps_ = 0;
+  int last_status_ = 0;
 };
 
 class PyVectorEnv {
@@ -499,9 +547,17 @@ class PyPolicy {
     const auto obs = FloatArray::ensure(observations);
     const int width = facts_.obs_size;
     if (!obs || (obs.ndim() != 1 && obs.ndim() != 2) || obs.shape(obs.ndim() - 1) != width) {
+      std::string got = obs ? "shape (" : "a " + type_name(observations);
+      for (py::ssize_t d = 0; obs && d < obs.ndim(); ++d) {
+        got += (d ? ", " : "") + std::to_string(obs.shape(d));
+      }
+      got += obs ? (obs.ndim() == 1 ? ",)" : ")") : "";
       throw py::value_error("observations must be a float array of shape (" + std::to_string(width) + ",) or (B, " +
-                            std::to_string(width) + ")" +
-                            (obs ? ", got ndim " + std::to_string(obs.ndim()) : ", got " + type_name(observations)));
+                            std::to_string(width) + ") for this policy's env '" + id_of(config_.env) + "', got " + got +
+                            (obs && obs.ndim() > 0 && obs.shape(obs.ndim() - 1) != width
+                                 ? " (an observation of another env? pamdp.evaluate(policy) plays the "
+                                   "checkpoint's own env)"
+                                 : ""));
     }
     const bool single = obs.ndim() == 1;
     const py::ssize_t batch = single ? 1 : obs.shape(0);
@@ -610,6 +666,7 @@ PYBIND11_MODULE(_pamdp, m) {
            py::arg("env_id"), py::arg("options"))
       .def("reset", &PyEnv::reset, py::arg("seed") = py::none(), py::arg("options") = py::none())
       .def("step", &PyEnv::step, py::arg("action"))
+      .def("render_text", &PyEnv::render_text)
       .def_property_readonly("env_id", [](const PyEnv& e) { return id_of(e.config()); })
       .def_property_readonly("config_toml", [](const PyEnv& e) { return env_toml(e.config()); })
       .def_property_readonly("observation_size", [](const PyEnv& e) { return e.env().observation_size(); })

@@ -6,6 +6,7 @@ vector env stepped in C++, and trained agents.
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     info["outcome"]                              # "IN_GAME", "GOAL", "OUT_OF_BOUNDS", ...
+    print(env.render("ansi"))                    # the field as text
 
 Actions (MP-DQN's convention for parameterized action spaces): a pair (id, params) where id is
 the discrete action (HFO: 0 DASH, 1 TURN, 2 TACKLE, 3 KICK) and params is a tuple with one
@@ -13,12 +14,16 @@ float32 array per discrete action holding that action's parameters (HFO: DASH (p
 TURN (dir,), TACKLE (dir,), KICK (power, dir)); only params[id] is read. params may also be
 one flat array of every parameter in the env's shared order (HFO: dash_power, dash_dir,
 turn_dir, tackle_dir, kick_power, kick_dir), the layout of a P-DQN or PA-DDPG actor's output.
-action_space is Tuple(Discrete(n), Tuple(Box per action)); parameters outside the bounds are
-clamped by the env, as the real HFO does.
+action_space is Tuple(Discrete(n), Tuple(Box per action)). A parameter outside the bounds is
+neither refused nor clipped to them here: the env clamps it to the range it accepts, as the real
+HFO does (HFO: powers to the server's range, where a negative dash power dashes backward;
+directions to [-180, 180]), so that Python plays what `pamdp eval` plays. Env warns once when it
+meets one; gymnasium.wrappers.ClipAction clips to the bounds instead.
 
 Episodes end with terminated (a terminal outcome: GOAL, OUT_OF_BOUNDS, CAPTURED_BY_DEFENSE) or
 truncated (OUT_OF_TIME, the time limit); info["outcome"] names it and info["status"] gives
-its code. Env options are keyword arguments named as the config file's env.* keys
+its code. While an episode goes on info["outcome"] is "IN_GAME" in every env (HFO's word; the
+toy envs' C++ traces call it IN_PROGRESS), info["status"] 0. Env options are keyword arguments named as the config file's env.* keys
 (pamdp.make("hfo-1v0", noise=False, start="hfo")), validated the same way.
 """
 
@@ -34,7 +39,8 @@ import numpy as np
 from . import _pamdp
 from . import spaces
 
-__all__ = ["Env", "VectorEnv", "Policy", "make", "make_vec", "load_policy", "evaluate", "env_ids", "spaces"]
+__all__ = ["Env", "EnvSpec", "VectorEnv", "Policy", "make", "make_vec", "load_policy", "evaluate", "env_ids",
+           "spaces"]
 
 
 def env_ids() -> dict:
@@ -85,21 +91,76 @@ def _options(env_id, options: dict) -> dict:
     return out
 
 
+class EnvSpec:
+    """What builds an env again, as gymnasium.envs.registration.EnvSpec says it: id, entry_point,
+    max_episode_steps and the keyword arguments; make() builds the same env."""
+
+    def __init__(self, id: str, max_episode_steps: int, kwargs: dict):
+        self.id = id
+        self.entry_point = "pamdp:make"
+        self.max_episode_steps = max_episode_steps
+        self.kwargs = dict(kwargs)
+
+    def make(self) -> "Env":
+        return make(self.id, **self.kwargs)
+
+    def __repr__(self):
+        return f"EnvSpec(id={self.id!r}, entry_point={self.entry_point!r}, " \
+               f"max_episode_steps={self.max_episode_steps}, kwargs={self.kwargs!r})"
+
+
 class Env(_pamdp.Env):
     """One env with Gymnasium's API: reset(seed=None, options=None) -> (obs, info) and
     step(action) -> (obs, reward, terminated, truncated, info). Observations are fresh float32
     arrays. A fresh env never seeded plays the episodes of seed 0; reset() without a seed
-    continues the env's own random stream, as `pamdp eval` does between episodes."""
+    continues the env's own random stream, as `pamdp eval` does between episodes.
 
-    metadata = {"render_modes": []}
-    render_mode = None
-    spec = None
+    As a gymnasium.Env: spec (EnvSpec: id and options), np_random (a NumPy Generator that
+    reset(seed=s) reseeds from s; the env's own dynamics draw from the C++ env's stream),
+    metadata["render_modes"] == ["ansi"] and render(): with render_mode="ansi" (make's keyword)
+    or render("ansi"), the field as text (HFO: the half field with agent, goalie and ball, then
+    their positions; the toy tasks: their state)."""
 
-    def __init__(self, env_id: str = "hfo-1v0", **options):
+    metadata = {"render_modes": ["ansi"]}
+
+    def __init__(self, env_id: str = "hfo-1v0", render_mode=None, **options):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         super().__init__(env_id, _options(env_id, options))
+        self.render_mode = render_mode
         bound = self.observation_bound
         self.observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
         self.action_space = spaces.action_space(self.actions)
+        self.spec = EnvSpec(self.env_id, self.max_episode_steps, options)
+        self._np_random = None
+        self._np_random_seed = None
+
+    def reset(self, seed=None, options=None):
+        obs, info = super().reset(seed, options)
+        if seed is not None:
+            self._np_random = np.random.default_rng(seed)
+            self._np_random_seed = seed
+        return obs, info
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        """Gymnasium's per-env generator, seeded by reset(seed=...) (from the OS until then)."""
+        if self._np_random is None:
+            self._np_random = np.random.default_rng()
+            self._np_random_seed = -1
+        return self._np_random
+
+    @np_random.setter
+    def np_random(self, value: np.random.Generator):
+        self._np_random = value
+        self._np_random_seed = -1
+
+    @property
+    def np_random_seed(self) -> int:
+        """The seed np_random was last seeded with (-1: not from a seed), as Gymnasium >= 1.0 has it."""
+        if self._np_random is None:
+            self.np_random  # noqa: B018 (creates it)
+        return self._np_random_seed
 
     @property
     def unwrapped(self):
@@ -112,8 +173,14 @@ class Env(_pamdp.Env):
         table = tomllib.loads(self.config_toml)["env"]
         return {k: table[k] for k in _pamdp.option_names(self.env_id)}
 
-    def render(self):
-        return None
+    def render(self, mode=None):
+        """The field as text for mode "ansi" (default: the env's render_mode); None without a mode."""
+        mode = self.render_mode if mode is None else mode
+        if mode is None:
+            return None
+        if mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render mode must be one of {self.metadata['render_modes']}, got {mode!r}")
+        return self.render_text()
 
     def close(self):
         pass
@@ -198,10 +265,19 @@ class Policy(_pamdp.Policy):
         return f"pamdp.Policy({self.algorithm}, env '{self.env_id}', {self.updates} updates, actor {self.actor})"
 
 
-def make(env_id: str = "hfo-1v0", **options) -> Env:
+def make(env_id: str = "hfo-1v0", render_mode=None, **options) -> Env:
     """A new env: make("hfo-1v0"), make("hfo-1v1"), make("reach_stop"), make("hfo", goalie=True),
-    with env options as keyword arguments (noise=False, start="hfo", max_steps=300, ...)."""
-    return Env(env_id, **options)
+    with env options as keyword arguments (noise=False, start="hfo", max_steps=300, ...) and
+    render_mode=None or "ansi" (env.render() then returns the field as text)."""
+    return Env(env_id, render_mode=render_mode, **options)
+
+
+def _ids_help() -> str:
+    return "\n\n    Env ids (pamdp.env_ids()):\n" + "\n".join(
+        f"      {env_id:<12} {description}" for env_id, description in _pamdp.env_ids())
+
+
+make.__doc__ += _ids_help()
 
 
 def make_vec(env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,
@@ -229,8 +305,19 @@ def load_policy(path, exploration: bool = False, epsilon=None, seed: int = 0, ac
 def evaluate(policy, env=None, episodes: int = 100, seed: int = 1) -> dict:
     """Plays `episodes` episodes as `pamdp eval` does (the first reset with `seed`, later ones
     continuing the env's stream) and returns its JSON keys: episodes, goal_rate,
-    avg_steps_to_goal, avg_return, avg_steps, outcomes. `env` defaults to policy.make_env()."""
-    env = policy.make_env() if env is None else env
+    avg_steps_to_goal, avg_return, avg_steps, outcomes. `env` is an Env or an env id as make()
+    takes it ("hfo-1v0", "platform", ...); it defaults to policy.make_env(), the checkpoint's
+    own env with its settings."""
+    if env is None:
+        env = policy.make_env()
+    elif isinstance(env, str):
+        env = make(env)
+    elif not hasattr(env, "success_status"):
+        raise TypeError(f"env must be a pamdp Env, an env id such as 'hfo-1v0' or None, got {type(env).__name__}")
+    policy_size = getattr(policy, "observation_size", None)
+    if policy_size is not None and policy_size != env.observation_size:
+        raise ValueError(f"the policy reads observations of {policy_size} floats (env '{policy.env_id}'), and env "
+                         f"'{env.env_id}' gives {env.observation_size}: evaluate it on its own env (env=None)")
     success = env.success_status
     outcomes = {name: 0 for status, name in env.outcomes if status != 0}
     total_return, total_steps, goal_steps, goals = 0.0, 0, 0, 0

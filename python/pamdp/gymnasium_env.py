@@ -11,10 +11,10 @@ from . import _pamdp, make, spaces
 class GymnasiumEnv(gymnasium.Env):
     """A pamdp env as a gymnasium.Env, with gymnasium.spaces for its spaces."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["ansi"]}
 
     def __init__(self, env_id: str = "hfo-1v0", render_mode=None, **options):
-        self._env = make(env_id, **options)
+        self._env = make(env_id, render_mode=render_mode, **options)
         self.render_mode = render_mode
         self.observation_space = spaces.to_gymnasium(self._env.observation_space)
         self.action_space = spaces.to_gymnasium(self._env.action_space)
@@ -25,6 +25,10 @@ class GymnasiumEnv(gymnasium.Env):
 
     def step(self, action):
         return self._env.step(action)
+
+    def render(self):
+        """The field as text with render_mode "ansi"; None without a render mode."""
+        return self._env.render()
 
 
 def register() -> None:

@@ -85,6 +85,12 @@ class MultiDiscrete(Space):
         return f"MultiDiscrete({self.nvec.tolist()})"
 
 
+def _bound_repr(bound: np.ndarray) -> str:
+    if bound.size and np.all(bound == bound.flat[0]):
+        return str(bound.flat[0])
+    return np.array2string(bound, separator=", ")
+
+
 class Box(Space):
     """Arrays of `shape` within [low, high] element-wise."""
 
@@ -117,7 +123,8 @@ class Box(Space):
         )
 
     def __repr__(self):
-        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
+        # As gymnasium.spaces.Box: one number when every entry shares a bound, else every entry's.
+        return f"Box({_bound_repr(self.low)}, {_bound_repr(self.high)}, {self.shape}, {self.dtype})"
 
 
 class Tuple(Space):

@@ -1,6 +1,6 @@
 """With Gymnasium importable, pamdp's envs are registered: gymnasium.make("pamdp/hfo-1v0") gives a
 gymnasium.Env that passes Gymnasium's own env checker. Gymnasium is not a Debian package, so
-without it this test is skipped (exit 77)."""
+without it this test is skipped (exit 77); test_conventions.py checks the same properties there."""
 
 import sys
 import unittest
@@ -33,6 +33,11 @@ class GymnasiumRegistration(unittest.TestCase):
                         self.assertIn(info["outcome"], ("GOAL", "OUT_OF_BOUNDS", "CAPTURED_BY_DEFENSE", "OUT_OF_TIME",
                                                         "SUCCESS", "WRONG_STOP"))
                         env.reset()
+        # Its render mode: the field as text.
+        env = gymnasium.make("pamdp/hfo-1v1", render_mode="ansi")
+        check_env(env.unwrapped)
+        env.reset(seed=1)
+        self.assertIn("A agent, G goalie", env.render())
         env = gymnasium.make("pamdp/hfo-1v0", noise=False)
         a, _ = env.reset(seed=1)
         b, _ = pamdp.make("hfo-1v0", noise=False).reset(seed=1)
