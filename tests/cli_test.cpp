@@ -420,6 +420,42 @@ TEST(Cli, SimTraceSetsAndReportsTheGoalie) {
   EXPECT_NEAR(std::stod(b[g + 7]), 156.152, 1e-2);
 }
 
+// Two offense players (issue 79): STATE.json's teammates, one action each per row separated by
+// '|', player 0's features (58 + 8 for the teammate) and every player's and the ball's state at
+// the end of each row. Both kick the touching ball in one cycle: player 0 (body 0) KICK 100 at
+// 0 pushes (2.7, 0), player 1 (body 180, from the other side) KICK 100 at 90 pushes (0, -2.7);
+// the sum is capped at 2.7, so the ball moves by (1.9091883, -1.9091883) (hfo_team_test).
+TEST(Cli, SimTraceWithTeammates) {
+  const TempFile state(".json", R"({"agent": {"x": 0, "y": 0, "body_deg": 0},
+                                    "teammates": [{"x": 0.77, "y": 0, "body_deg": 180}],
+                                    "ball": {"x": 0.385, "y": 0}})");
+  const TempFile actions(".csv", "KICK,100,0|KICK,100,90\n");
+  const RunResult r =
+      run_pamdp("sim trace --no-noise --init " + quoted(state.path()) + " --actions " + quoted(actions.path()),
+                Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<std::string> lines = split(r.output, '\n');
+  ASSERT_GE(lines.size(), 3U) << r.output;
+  const std::vector<std::string> header = split(lines[0], ',');
+  ASSERT_EQ(header.size(), 3U + 66U + 2U * 5U + 4U) << lines[0];
+  EXPECT_EQ(header[3 + 65], "f65");
+  EXPECT_EQ(header[3 + 66], "p0_x");
+  EXPECT_EQ(header[3 + 66 + 5], "p1_x");
+  EXPECT_EQ(header.back(), "b_vy");
+  const std::vector<std::string> after = split(lines[2], ',');
+  ASSERT_EQ(after.size(), header.size());
+  const double a = 2.7 / std::sqrt(2.0);
+  EXPECT_NEAR(std::stod(after[header.size() - 4]), 0.385 + a, 1e-6);
+  EXPECT_NEAR(std::stod(after[header.size() - 3]), -a, 1e-6);
+  EXPECT_NEAR(std::stod(after[header.size() - 2]), a * 0.94, 1e-6);
+  // A row with one action for two players is refused, naming the file and line.
+  const TempFile short_row(".csv", "KICK,100,0\n");
+  const RunResult bad =
+      run_pamdp("sim trace --init " + quoted(state.path()) + " --actions " + quoted(short_row.path()));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find(":1: expected 2 actions separated by '|'"), std::string::npos) << bad.output;
+}
+
 // The goalie's memory keys: the same state with the goalie still frozen for 2 cycles by its
 // own tackle sends no body command for two steps (the server would refuse it), and after its
 // own catch ("caught") it does not catch again: it keeps its position.
@@ -731,7 +767,7 @@ class TempRun {
   std::string path_;
 };
 
-// A learner whose join port is taken names the key that moves it.
+// A learner (or shard) whose port is taken names the key (or flag) that moves it.
 TEST(CliUserErrors, PortInUseNamesTheConfigKey) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   ASSERT_GE(fd, 0);
@@ -747,8 +783,11 @@ TEST(CliUserErrors, PortInUseNamesTheConfigKey) {
   const RunResult r = run_pamdp_stderr("learner --config " + kReachStop + " --run-dir " + quoted(run.path()) +
                                        " --set cluster.learner_bind=tcp://127.0.0.1:" + port +
                                        " --set cluster.weights_bind=tcp://127.0.0.1:0 --metrics-port 0");
+  const RunResult shard = run_pamdp_stderr(
+      "replay --join tcp://127.0.0.1:1 --join-timeout 1 --insert-bind tcp://127.0.0.1:" + port + " --metrics-port 0");
   ::close(fd);
   expect_one_error_line(r, {port, "in use", "--set cluster.learner_bind=tcp://127.0.0.1:PORT"});
+  expect_one_error_line(shard, {port, "in use", "--insert-bind tcp://127.0.0.1:PORT"});
 }
 
 // A tiny run of the toy task (seconds), for the tests below.
