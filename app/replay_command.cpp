@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -88,7 +89,20 @@ void run_replay(const ReplayCliOptions& o) {
       std::make_unique<MetricsEndpoint>("replay", options.name, o.metrics_bind, o.metrics_port, o.advertise_host);
   options.metrics_url = endpoint->url();
   export_security_mode(endpoint->registry(), security, insecure, endpoints);
-  ShardServer server(ctx, options, shard_config_from_toml);
+  std::optional<ShardServer> bound;
+  try {
+    bound.emplace(ctx, options, shard_config_from_toml);
+  } catch (const std::runtime_error& e) {
+    // The socket layer names the endpoint; the user changes it with the flag that gave it.
+    const std::string what = e.what();
+    if (what.find("cannot bind") == std::string::npos) {
+      throw;
+    }
+    const char* flag = what.find("'" + o.sample_bind + "'") != std::string::npos ? "--sample-bind" : "--insert-bind";
+    throw std::runtime_error("pamdp replay: " + what + "; choose another with " + flag +
+                             " tcp://127.0.0.1:PORT (port 0: any free port, the default)");
+  }
+  ShardServer& server = *bound;
   register_shard_metrics(endpoint->registry(), server);
   // The endpoint's scrapes read the server: stop serving them before the server goes.
   const struct StopMetricsFirst {
