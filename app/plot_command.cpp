@@ -249,7 +249,7 @@ void run_plot(const PlotOptions& o) {
 void register_plot(CLI::App& app) {
   auto o = std::make_shared<PlotOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "plot", "draw learning curves (goal rate, return, mean Q, critic loss) of run directories into a PNG");
+      "plot", "draw learning curves (goal or success rate, return, mean Q, critic loss) of run directories into a PNG");
   cmd->add_option("runs", o->runs, "run directories (written by pamdp train or pamdp learner); several are overlaid")
       ->required()
       ->check(existing_directory("give the run directory of a pamdp train or pamdp learner run (runs/... by "
