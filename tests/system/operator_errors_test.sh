@@ -22,8 +22,9 @@ failures=0
 cases=0
 config=$src/deploy/configs/reach_stop.toml
 
-# expect_error NAME TIMEOUT_S PATTERN... -- COMMAND...: COMMAND must exit non-zero within
-# TIMEOUT_S, and one line of its stderr must match every PATTERN (grep -E, case-insensitive).
+# expect_error NAME TIMEOUT_S PATTERN... -- COMMAND...: COMMAND must exit with status 2 (pamdp
+# --help's "an error you can fix") within TIMEOUT_S, and one line of its stderr, starting
+# "pamdp: error: ", must match every PATTERN (grep -E, case-insensitive).
 expect_error() {
   local name=$1 limit=$2
   shift 2
@@ -38,13 +39,13 @@ expect_error() {
   timeout "$limit" "$@" >"$work/$cases.out" 2>"$out" </dev/null || status=$?
   local took=$((SECONDS - start))
   local lines
-  lines=$(cat "$out")
+  lines=$(grep '^pamdp: error: ' "$out" || true)
   for p in "${patterns[@]}"; do
     lines=$(grep -iE -- "$p" <<<"$lines" || true)
   done
   local error_lines
   error_lines=$(grep -ciE 'error|fatal' "$out" || true)
-  if ((status == 0 || status == 124)) || [[ -z $lines ]]; then
+  if ((status != 2)) || [[ -z $lines ]]; then
     failures=$((failures + 1))
     echo "FAIL  $name: status $status after ${took}s; stderr:" >&2
     sed 's/^/      /' "$out" | head -n 12 >&2
