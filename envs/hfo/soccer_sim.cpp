@@ -356,7 +356,7 @@ bool SoccerSim::kick_player_server(int i, double power, double dir_deg) {
   return true;
 }
 
-bool SoccerSim::server_tackle(int i, double dir_deg) {
+bool SoccerSim::server_tackle(int i, double dir_deg, std::optional<bool> succeeds) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
@@ -376,8 +376,8 @@ bool SoccerSim::server_tackle(int i, double dir_deg) {
   if (fail >= 1.0) {
     return true;
   }
-  // Success is drawn from the server's generator even with noise off.
-  if (rng_.uniform() < fail) {
+  // Success is drawn from the server's generator even with noise off (a replay may give it).
+  if (succeeds ? !*succeeds : rng_.uniform() < fail) {
     return true;
   }
   const double a_deg = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
@@ -435,7 +435,8 @@ bool SoccerSim::goalie_catch(int player, double dir_deg) {
   return true;
 }
 
-bool SoccerSim::command_as_received(int player, const char* kind, double p1, double p2) {
+bool SoccerSim::command_as_received(int player, const char* kind, double p1, double p2,
+                                    std::optional<bool> tackle_succeeds) {
   sense_goalie();
   const std::string_view k(kind);
   if (k == "DASH") {
@@ -452,7 +453,7 @@ bool SoccerSim::command_as_received(int player, const char* kind, double p1, dou
     return kick_player_server(player, p1, p2);
   }
   if (k == "TACKLE") {
-    return server_tackle(player, p1);
+    return server_tackle(player, p1, tackle_succeeds);
   }
   if (k == "CATCH") {
     return goalie_catch(player, p1);

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "core/rng.hpp"
@@ -180,8 +181,11 @@ class SoccerSim {
 
   // A body command exactly as the server received it from `player`'s client (recorded logs,
   // the goalie): DASH power dir, TURN moment, KICK power dir, TACKLE dir, CATCH dir; no client
-  // processing. Returns false if the server refuses it.
-  bool command_as_received(int player, const char* kind, double p1, double p2);
+  // processing. Returns false if the server refuses it. A tackle's success is the server's
+  // random draw even with noise off, so a replay may give the logged outcome (`tackle_succeeds`);
+  // without it the draw is made as in play. A tackle the geometry rules out still fails.
+  bool command_as_received(int player, const char* kind, double p1, double p2,
+                           std::optional<bool> tackle_succeeds = std::nullopt);
 
   // Advances one server cycle (movement, collisions, referee, stamina) and returns the status.
   int step();
@@ -198,7 +202,7 @@ class SoccerSim {
   bool kick_player_server(int i, double power, double dir_deg);
   bool server_dash(int i, double power, double dir_deg);
   bool server_turn(int i, double moment);
-  bool server_tackle(int i, double dir_deg);
+  bool server_tackle(int i, double dir_deg, std::optional<bool> succeeds = std::nullopt);
   // The goalie senses the cycle's state before any command of the cycle changes it (a turn
   // takes effect when the server receives it): decided once, at the first command or step().
   void sense_goalie();
