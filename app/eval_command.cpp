@@ -21,6 +21,7 @@
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/scripted_team.hpp"
 #include "envs/hfo/settings.hpp"
 #include "envs/registry.hpp"
 #include "learner/checkpoint.hpp"
@@ -341,7 +342,18 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
   }
   auto env = make_env(c.env);
   std::unique_ptr<Policy> policy;
-  if (o.policy == "scripted") {
+  const int teammates =
+      c.env.params.contains("offense_agents") ? static_cast<int>(c.env.params.integer("offense_agents")) - 1 : 0;
+  if (o.policy == "scripted" && teammates > 0) {
+    // One player of a team (env.offense_agents on the real server): the scripted team player.
+    if (shot_given) {
+      throw std::runtime_error(
+          "--shot aims the single striker's shots; a team player (env.offense_agents > 1) "
+          "plays the close-in offense: leave out --shot");
+    }
+    policy = std::make_unique<hfo::ScriptedTeamPlayer>(teammates, c.env.params.boolean("goalie") ? 1 : 0,
+                                                       hfo::shoot_action(c.env.params));
+  } else if (o.policy == "scripted") {
     policy = std::make_unique<hfo::ScriptedOffense>(o.shot, hfo::shoot_action(c.env.params));
   } else if (hfo_actions) {
     // The paper's exploration draw: Tackle masked, dash power U[-100, 100] (reference §7.3).

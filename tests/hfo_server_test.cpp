@@ -475,6 +475,12 @@ TEST(HfoServerEnv, ObservationSizesComeFromTheConfig) {
   EXPECT_EQ(app::observation_size(e), 66);
   e.params.set("server_encoding", std::string("native"));
   EXPECT_EQ(app::observation_size(e), 68);
+  // One of two offense agents (bin/HFO --offense-agents 2): a teammate block and its uniform
+  // number more, 58 + 9 + 9 + 1 = 77 native, 58 + 8 + 8 = 74 embedded.
+  e.params.set("offense_agents", int64_t{2});
+  EXPECT_EQ(app::observation_size(e), 77);
+  e.params.set("server_encoding", std::string("embedded"));
+  EXPECT_EQ(app::observation_size(e), 74);
 }
 
 // Without HFO the env name is known but making one names the fix; with HFO, making one opens no

@@ -72,8 +72,8 @@ class HfoServerEnv final : public Env {
  public:
   explicit HfoServerEnv(HfoServerConfig config)
       : c_(std::move(config)),
-        native_size_(e3_feature_count(0, c_.opponents)),
-        embedded_(static_cast<size_t>(hfo::feature_count(1 + c_.opponents))) {}
+        native_size_(e3_feature_count(c_.teammates, c_.opponents)),
+        embedded_(static_cast<size_t>(hfo::feature_count(1 + c_.teammates + c_.opponents))) {}
 
   ~HfoServerEnv() override {
     if (client_ != nullptr) {
@@ -167,12 +167,13 @@ class HfoServerEnv final : public Env {
     const int teammates = client_->getNumTeammates();
     const int opponents = client_->getNumOpponents();
     const auto features = static_cast<int>(client_->getState().size());
-    if (teammates != 0 || opponents != c_.opponents || features != native_size_) {
+    if (teammates != c_.teammates || opponents != c_.opponents || features != native_size_) {
       throw std::runtime_error("hfo-server: the server at " + address(c_) + " runs " + std::to_string(teammates) +
                                " teammate(s) and " + std::to_string(opponents) + " opponent(s) (" +
-                               std::to_string(features) + " features); this env expects 0 and " +
-                               std::to_string(c_.opponents) +
-                               " (env.goalie = true for a server started with --defense-npcs 1)");
+                               std::to_string(features) + " features); this env expects " +
+                               std::to_string(c_.teammates) + " and " + std::to_string(c_.opponents) +
+                               " (env.offense_agents = N for a server started with --offense-agents N, env.goalie "
+                               "= true for one with --defense-npcs 1)");
     }
     // The state at connection is the one before kick-off; the server places ball and players for
     // the first episode in the first cycle of play. Two NOOPs make the first observation, like
@@ -211,7 +212,7 @@ class HfoServerEnv final : public Env {
       throw std::runtime_error("hfo-server: the server sent " + std::to_string(state.size()) + " features, expected " +
                                std::to_string(native_size_));
     }
-    e3_to_embedded(state, 0, c_.opponents, embedded_);
+    e3_to_embedded(state, c_.teammates, c_.opponents, embedded_);
     if (c_.encoding == Encoding::kNative) {
       std::copy(state.begin(), state.end(), obs.begin());
     } else {

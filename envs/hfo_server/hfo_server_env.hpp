@@ -5,7 +5,10 @@
 // Contract beyond envs/env.hpp:
 //  - One env is one player of one running server (`bin/HFO --offense-agents 1 --fullstate
 //    --headless --port P`); the server must be started before the env's first reset() and
-//    ends when the env disconnects (HFO's trainer stops the game when its agent leaves).
+//    ends when the env disconnects (HFO's trainer stops the game when its agent leaves). With
+//    --offense-agents N (env.offense_agents = N) each of N processes plays one of them, and the
+//    server, in synchronous mode, runs a cycle once every agent has acted: a team plays in
+//    lockstep by itself.
 //  - Connects lazily, on the first reset(): constructing one (to learn the observation size, as
 //    the learner and replay shards do) opens no socket. Connecting allocates; steps then do not,
 //    apart from what HFO's client library does inside.
@@ -53,6 +56,7 @@ struct HfoServerConfig {
   // agent2d formation files; empty: the HFO_ROOT given to CMake + bin/teams/base/config/formations-dt.
   std::string config_dir;
   int opponents = 0;           // defense players on the server: 1 with bin/HFO --defense-npcs 1 (a goalie)
+  int teammates = 0;           // the other learned offense players: bin/HFO --offense-agents N gives N - 1
   int max_steps = 500;         // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
   int connect_timeout_s = 30;  // how long the first reset() waits for a server to answer (env.server_connect_timeout_s)
   bool shoot_action = false;   // the action space with SHOOT, a second kick (env.shoot_action, envs/hfo/hfo_env.hpp)
@@ -64,10 +68,11 @@ struct HfoServerConfig {
 // cores running two other jobs, and more than 3.5 s at a load average of 12 (docs/hfo-server.md).
 inline constexpr double kTrainerFillS = 10.0;
 
-// Observation width for `config` (native: 59 + 9 * opponents; embedded: 58 + 8 * opponents).
+// Observation width for `config` (native: 59 + 9 * (teammates + opponents); embedded:
+// 58 + 8 * (teammates + opponents)).
 inline int observation_size(const HfoServerConfig& config) {
-  return config.encoding == Encoding::kNative ? e3_feature_count(0, config.opponents)
-                                              : hfo::feature_count(1 + config.opponents);
+  return config.encoding == Encoding::kNative ? e3_feature_count(config.teammates, config.opponents)
+                                              : hfo::feature_count(1 + config.teammates + config.opponents);
 }
 
 // The settings the env.* keys of env 'hfo-server' give (envs/hfo_server/registration.cpp).

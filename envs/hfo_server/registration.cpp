@@ -4,6 +4,7 @@
 
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/settings.hpp"
+#include "envs/hfo/soccer_sim.hpp"
 #include "envs/hfo_server/hfo_server_env.hpp"
 #include "envs/registry.hpp"
 
@@ -23,6 +24,7 @@ HfoServerConfig server_config(const EnvParams& p) {
   s.team = p.text("server_team");
   s.config_dir = p.text("server_config_dir");
   s.opponents = p.boolean("goalie") ? 1 : 0;
+  s.teammates = static_cast<int>(p.integer("offense_agents")) - 1;
   s.max_steps = static_cast<int>(p.integer("max_steps"));
   s.connect_timeout_s = static_cast<int>(p.integer("server_connect_timeout_s"));
   s.shoot_action = p.boolean("shoot_action");
@@ -47,7 +49,9 @@ void register_hfo_server_env(EnvRegistry& registry) {
             EnvKey::choice("server_encoding", hfo_server::kEncodingNames[static_cast<int>(d.encoding)],
                            {hfo_server::kEncodingNames[0], hfo_server::kEncodingNames[1]}),
             EnvKey::text("server_team", d.team), EnvKey::text_or_empty("server_config_dir", d.config_dir),
-            EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600), hfo::shoot_action_key()};
+            EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600), hfo::shoot_action_key(),
+            // bin/HFO --offense-agents N: this env plays one of the N, the others are other processes.
+            EnvKey::integer("offense_agents", d.teammates + 1, 1, hfo::kMaxOffenseAgents)};
   r.make = [](const EnvParams& p) { return hfo_server::make_hfo_server_env(hfo_server::server_config(p)); };
   r.observation_size = [](const EnvParams& p) { return hfo_server::observation_size(hfo_server::server_config(p)); };
   r.gives_embedded_hfo_features = [](const EnvParams& p) { return p.text("server_encoding") == "embedded"; };
