@@ -621,12 +621,22 @@ def cmd_parse(a):
     header = ['src', 'ep', 't', 'cycle', 'status', 'tags', 'bx', 'by', 'bvx', 'bvy']
     for name, _ in players:
         header += [name + s for s in ('_x', '_y', '_vx', '_vy', '_body', '_stamina',
-                                      '_effort', '_recovery', '_state', '_cmd', '_c1', '_c2')]
+                                      '_effort', '_recovery', '_state', '_frozen', '_cmd',
+                                      '_c1', '_c2')]
         if name != 'g':
             header += [name + '_req', name + '_r1', name + '_r2']
     for k in range(len(agents)):
         header += ['f%d_%d' % (k, j) for j in range(nfs[k])]
 
+    tackle_cycles = 10
+    with open(rcgs[0], errors='replace') as fh:
+        for line in fh:
+            m = re.search(r'\(tackle_cycles (\d+)\)', line)
+            if m:
+                tackle_cycles = int(m.group(1))
+                break
+    tackles = {key: sorted(T for (T, sd, un), c in cmds.items()
+                           if (sd, un) == key and c[0][0] == 'tackle') for _, key in players}
     stats = {'episodes': 0, 'cycles': 0, 'statuses': {}, 'pcoll_cycles': 0,
              'bcoll_cycles': 0, 'double_kick_cycles': 0, 'double_kick_cmd_cycles': 0,
              'kicks': 0, 'tackles': 0, 'rows_with_features': [0] * len(agents)}
@@ -681,6 +691,11 @@ def cmd_parse(a):
                 row += [''] * 9
             else:
                 row += [fmt(x) for x in p[:8]] + ['0x%x' % p[8]]
+            # cycles the player stays frozen by its own last tackle (in any episode)
+            import bisect
+            tl = tackles[key]
+            j = bisect.bisect_left(tl, T)
+            row.append(str(max(0, tackle_cycles - (T - tl[j - 1])) if j > 0 else 0))
             c = cmds.get((T,) + key, [])
             if c:
                 body = c[0]
