@@ -20,6 +20,7 @@
 #include "app/sim_options.hpp"
 #include "core/policy.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
 #include "envs/hfo/scripted_offense.hpp"
 #include "envs/hfo/scripted_team.hpp"
 #include "envs/hfo/settings.hpp"
@@ -44,6 +45,7 @@ struct EvalOptions {
       ActorCopy::kOnline;  // which actor of a checkpoint plays (--actor; unset: the one its run evaluated)
   bool agreement = false;  // the scripted offense plays, the checkpoint's actor is asked
   hfo::ShotAim shot = hfo::ShotAim::kBestCourse;  // the scripted offense's (--shot)
+  int offense_agents = 1;                         // --offense-agents: a team in the embedded simulator
   SimOptions sim;
 };
 
@@ -298,7 +300,97 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   print_result(std::string(algorithm->name()), evaluate_with_progress(std::move(env), policy, o), o.json);
 }
 
+// --offense-agents N: N players in one embedded game (HfoTeamEnv), the scripted team player or
+// the paper's random draw in every slot. The row is the team's: its scoring rate and steps to
+// goal; the return is the mean of the players' returns.
+void run_team_eval(const EvalOptions& o, const CLI::App& cmd) {
+  if (!o.checkpoint.empty() || !o.trace.empty() || o.agreement || cmd.count("--shot") > 0 || cmd.count("--actor") > 0) {
+    throw std::runtime_error(
+        "--offense-agents plays a team of scripted or random players; --checkpoint, --trace, --agreement, --shot "
+        "and --actor are for one agent: leave them out, or leave out --offense-agents");
+  }
+  if (!o.env.empty() && o.env != "hfo") {
+    throw std::runtime_error(
+        "--offense-agents plays the embedded simulator; on the real server each agent is a "
+        "process of its own: --env hfo-server --set env.offense_agents=" +
+        std::to_string(o.offense_agents) + " in each");
+  }
+  if (!o.sets.empty()) {
+    throw std::runtime_error(
+        "--set changes one agent's env; with --offense-agents use the simulator flags "
+        "(--goalie, --start, --no-noise, ...)");
+  }
+  hfo::SoccerSimConfig cfg = o.sim.resolved();
+  cfg.offense_agents = o.offense_agents;
+  hfo::HfoTeamEnv env(cfg);
+  const int n = env.agents();
+  const auto width = static_cast<size_t>(env.observation_size());
+  std::vector<std::unique_ptr<Policy>> players;
+  for (int i = 0; i < n; ++i) {
+    if (o.policy == "scripted") {
+      players.push_back(std::make_unique<hfo::ScriptedTeamPlayer>(n - 1, cfg.goalie ? 1 : 0));
+    } else {
+      auto random = std::make_unique<RandomPolicy>(env.action_space(), (o.seed ^ 0x5eedULL) + static_cast<uint64_t>(i),
+                                                   std::vector<int>{hfo::kDash, hfo::kTurn, hfo::kKick});
+      random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
+      players.push_back(std::move(random));
+    }
+  }
+  std::vector<float> obs(width * static_cast<size_t>(n));
+  std::vector<float> rewards(static_cast<size_t>(n));
+  std::vector<ParamAction> actions(static_cast<size_t>(n));
+  EvalResult r;
+  for (const char* name : {"GOAL", "CAPTURED_BY_DEFENSE", "OUT_OF_BOUNDS", "OUT_OF_TIME"}) {
+    r.outcomes[name] = 0;
+  }
+  ProgressBar bar("episodes", o.episodes);
+  double total_return = 0.0;
+  double total_steps = 0.0;
+  double steps_to_goal = 0.0;
+  int goals = 0;
+  env.reset(o.seed, obs);
+  for (int e = 0; e < o.episodes; ++e) {
+    if (e > 0) {
+      env.reset(obs);
+    }
+    for (auto& p : players) {
+      p->begin_episode();
+    }
+    int status = hfo::kInGame;
+    int steps = 0;
+    while (status == hfo::kInGame) {
+      for (int i = 0; i < n; ++i) {
+        actions[static_cast<size_t>(i)] = players[static_cast<size_t>(i)]->act(
+            std::span<const float>(obs).subspan(static_cast<size_t>(i) * width, width));
+      }
+      status = env.step(actions, obs, rewards);
+      ++steps;
+      for (float reward : rewards) {
+        total_return += reward / n;
+      }
+    }
+    ++r.outcomes[hfo::status_name(status)];
+    total_steps += steps;
+    if (status == hfo::kGoal) {
+      ++goals;
+      steps_to_goal += steps;
+    }
+    bar.update(e + 1);
+  }
+  bar.finish();
+  r.episodes = o.episodes;
+  r.goal_rate = static_cast<double>(goals) / o.episodes;
+  r.avg_steps_to_goal = goals > 0 ? steps_to_goal / goals : 0.0;
+  r.avg_return = total_return / o.episodes;
+  r.avg_steps = total_steps / o.episodes;
+  print_result(o.policy + " team of " + std::to_string(n), r, o.json);
+}
+
 void run_eval(const EvalOptions& o, const CLI::App& cmd) {
+  if (o.offense_agents > 1) {
+    run_team_eval(o, cmd);
+    return;
+  }
   if (!o.checkpoint.empty()) {
     run_checkpoint_eval(o, cmd);
     return;
@@ -395,6 +487,12 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember(env_registry().names()));
   cmd->add_option("--set", opts->sets,
                   "override an env setting, e.g. --set env.server_port=7000 (repeatable; env.* keys of the config)");
+  cmd->add_option("--offense-agents", opts->offense_agents,
+                  "N learned-agent slots in one embedded game (HFO's --offense-agents), each played by the "
+                  "scripted team player (--policy scripted: chase, support, dribble, pass, shoot) or the random "
+                  "draw; the row is the team's")
+      ->check(CLI::Range(1, hfo::kMaxOffenseAgents))
+      ->capture_default_str();
   const std::map<std::string, ActorCopy> actors{
       {"online", ActorCopy::kOnline}, {"target", ActorCopy::kTarget}, {"average", ActorCopy::kAverage}};
   cmd->add_option("--actor", opts->actor,
