@@ -420,6 +420,23 @@ TEST(Cli, SimTraceSetsAndReportsTheGoalie) {
   EXPECT_NEAR(std::stod(b[g + 7]), 156.152, 1e-2);
 }
 
+// pamdp eval --offense-agents 2: the scripted team in one embedded 2v1 game (.93 on 1,000
+// episodes); a checkpoint is one agent's and is refused with the fix.
+TEST(Cli, EvalPlaysAScriptedTeam) {
+  const RunResult r =
+      run_pamdp("eval --offense-agents 2 --goalie --start hfo --episodes 100 --seed 2 --json", Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string json = last_line(r.output);
+  const auto at = json.find("\"goal_rate\":");
+  ASSERT_NE(at, std::string::npos) << json;
+  EXPECT_GT(std::stod(json.substr(at + 12)), 0.8) << json;
+  EXPECT_NE(json.find("\"episodes\":100"), std::string::npos) << json;
+  const RunResult bad =
+      run_pamdp("eval --offense-agents 2 --checkpoint " + quoted(PAMDP_SOURCE_DIR "/models/hfo-1v0-fast-seed1.ckpt"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("leave out --offense-agents"), std::string::npos) << bad.output;
+}
+
 // Two offense players (issue 79): STATE.json's teammates, one action each per row separated by
 // '|', player 0's features (58 + 8 for the teammate) and every player's and the ball's state at
 // the end of each row. Both kick the touching ball in one cycle: player 0 (body 0) KICK 100 at
