@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -50,14 +51,18 @@ struct RunCurves {
   std::string label;
   std::vector<std::vector<double>> columns;  // x, success, return, q, loss, eval success (at evaluations only)
   std::string setup;                         // "env hfo, ddpg, seed 1" from its config.toml; "" if unreadable
-  bool goal = false;                         // its env's success is a goal (GOAL): "goal rate", else "success rate"
+  std::string task;                          // "env hfo, ddpg": the same without the seed
+  uint64_t seed = 0;
+  bool goal = false;  // its env's success is a goal (GOAL): "goal rate", else "success rate"
 };
 
 // The run's env, learner and seed from its config.toml, and whether its success is a goal.
 void read_setup(const std::string& dir, RunCurves& run) {
   try {
     const ExperimentConfig c = load_experiment_config((fs::path(dir) / "config.toml").string(), {});
-    run.setup = "env " + c.env.name + ", " + c.train.algorithm + ", seed " + std::to_string(c.seed);
+    run.task = "env " + c.env.name + ", " + c.train.algorithm;
+    run.seed = c.seed;
+    run.setup = run.task + ", seed " + std::to_string(c.seed);
     const std::unique_ptr<Env> env = make_env(c.env);
     run.goal = env->success_status() >= 0 && env->status_name(env->success_status()) == "GOAL";
   } catch (const std::exception&) {
@@ -191,10 +196,23 @@ void run_plot(const PlotOptions& o) {
     goal = goal && r.goal;
   }
   const std::string rate = goal ? "goal rate" : "success rate";
-  // The title: what was trained. One run: its directory, env, learner and seed; several: each.
+  // The title: what was trained. One run: its directory, env, learner and seed; several of one
+  // task (env and learner): the task and the seeds, which fits a line however many; else each.
   std::string title;
+  bool one_task = runs.size() > 1;
+  std::set<uint64_t> seeds;
   for (const RunCurves& r : runs) {
-    title += (title.empty() ? "" : "   |   ") + r.label + (r.setup.empty() ? "" : " (" + r.setup + ")");
+    one_task = one_task && !r.task.empty() && r.task == runs.front().task && seeds.insert(r.seed).second;
+  }
+  if (one_task) {
+    title = runs.front().task + ": " + std::to_string(runs.size()) + " runs, seeds ";
+    for (size_t r = 0; r < runs.size(); ++r) {
+      title += (r ? ", " : "") + std::to_string(runs[r].seed);
+    }
+  } else {
+    for (const RunCurves& r : runs) {
+      title += (title.empty() ? "" : "   |   ") + r.label + (r.setup.empty() ? "" : " (" + r.setup + ")");
+    }
   }
   std::ostringstream g;
   g << "set terminal pngcairo size " << o.width << ',' << o.height << " font 'sans,10' noenhanced\n"
@@ -210,7 +228,10 @@ void run_plot(const PlotOptions& o) {
                    bool with_eval) {
     // The rate rises from the bottom left to the top right: its legend goes top left, and names
     // every run's colour for the other panels too, which need none of their own.
-    const std::string key = with_eval ? "set key top left opaque box\n" : "unset key\n";
+    // With several runs the legend goes bottom right, where the rising curves leave room.
+    const std::string key = !with_eval         ? "unset key\n"
+                            : runs.size() == 1 ? "set key top left opaque box\n"
+                                               : "set key bottom right opaque box\n";
     g << "set title " << quoted(panel_title) << "\nset ylabel " << quoted(y_label) << "\n" << key << extra << "plot ";
     for (size_t r = 0; r < runs.size(); ++r) {
       const std::string file = quoted((tmp / ("run" + std::to_string(r) + ".dat")).string());
@@ -218,8 +239,11 @@ void run_plot(const PlotOptions& o) {
       g << (r ? ", " : "") << file << " using 1:" << column << " with lines lw 2 lc " << r + 1 << " title "
         << quoted(name);
       if (with_eval && any_eval) {
+        // One legend entry for the evaluation points: their colour is their run's line.
         g << ", " << file << " using 1:6 with points pt 7 ps 1.6 lc " << r + 1 << " title "
-          << quoted(runs.size() == 1 ? std::string("greedy evaluation") : runs[r].label + ": greedy evaluation");
+          << (r == 0 ? quoted(runs.size() == 1 ? std::string("greedy evaluation")
+                                               : std::string("greedy evaluations (points, in each run's colour)"))
+                     : std::string("''"));
       }
     }
     g << "\nunset logscale y\nset autoscale y\n";

@@ -534,6 +534,24 @@ TEST(Plot, DrawsTheCurvesOfARealRun) {
   EXPECT_NE(out.find("toy (env reach_stop, ddpg, seed 1)"), std::string::npos) << out;
   EXPECT_NE(out.find("; success rate with greedy evaluations"), std::string::npos) << out;
   EXPECT_EQ(out.find("goal rate"), std::string::npos) << out;
+  // Runs of one task with different seeds: the task and the seeds, on a line of any length.
+  const fs::path seed2 = dir / "seed2";
+  fs::create_directories(seed2);
+  fs::copy_file(run_dir / "metrics.csv", seed2 / "metrics.csv");
+  {
+    std::ifstream cfg(run_dir / "config.toml");
+    std::ofstream copy(seed2 / "config.toml");
+    std::string line;
+    while (std::getline(cfg, line)) {
+      copy << (line.rfind("seed = ", 0) == 0 ? std::string("seed = 2") : line) << "\n";
+    }
+  }
+  out.clear();
+  ASSERT_EQ(run("'" + pamdp + "' plot '" + run_dir.string() + "' '" + seed2.string() + "' --out '" + png.string() + "'",
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("env reach_stop, ddpg: 2 runs, seeds 1, 2;"), std::string::npos) << out;
 
   out.clear();
   EXPECT_NE(run("'" + pamdp + "' plot '" + dir.string() + "'", &out), 0);  // not a run directory
