@@ -107,7 +107,9 @@ void write_features(const SoccerState& state, int self_index, std::span<float> o
     }
   }
   const Team my_team = self.team;
-  std::sort(order.begin(), order.begin() + n, [&](int a, int c) {
+  // Teammates first, then opponents, each nearest first (ties by index): an insertion sort of at
+  // most kMaxPlayers - 1 entries.
+  const auto before = [&](int a, int c) {
     const PlayerState& pa = state.players[a];
     const PlayerState& pc = state.players[c];
     const bool ta = pa.team == my_team;
@@ -118,7 +120,15 @@ void write_features(const SoccerState& state, int self_index, std::span<float> o
     const double da = (pa.pos - p).r2();
     const double dc = (pc.pos - p).r2();
     return da != dc ? da < dc : a < c;
-  });
+  };
+  for (int i = 1; i < n; ++i) {
+    const int v = order[i];
+    int j = i;
+    for (; j > 0 && before(v, order[j - 1]); --j) {
+      order[j] = order[j - 1];
+    }
+    order[j] = v;
+  }
   float* block = f + kNumAgentFeatures;
   std::fill(block, block + static_cast<ptrdiff_t>(kFeaturesPerPlayer) * others, 0.0F);
   int teammates = 0;
@@ -148,6 +158,20 @@ void write_features(const SoccerState& state, int self_index, std::span<float> o
 
 double proximity_to_distance(float proximity) {
   return (1.0 - static_cast<double>(proximity)) * 0.5 * kMaxDistance;
+}
+
+Vec2 body_frame_position(std::span<const float> f, size_t index) {
+  const double d = proximity_to_distance(f[index + 2]);
+  return {d * f[index + 1], d * f[index]};
+}
+
+Vec2 ball_velocity_in_body_frame(std::span<const float> f) {
+  const double speed = 0.5 * (f[feat::kBallSpeed] + 1.0) * 5.0;
+  const double vgx = speed * f[feat::kBallVelAngleCos];
+  const double vgy = speed * f[feat::kBallVelAngleSin];
+  const double bs = f[feat::kBodySin];
+  const double bc = f[feat::kBodyCos];
+  return {vgx * bc + vgy * bs, -vgx * bs + vgy * bc};
 }
 
 }  // namespace pamdp::hfo

@@ -66,4 +66,11 @@ void write_features(const SoccerState& state, int self, std::span<float> out);
 // Metres represented by one unit of proximity feature (2 / R = 0.031975 per metre).
 double proximity_to_distance(float proximity);
 
+// Read back from a feature vector, in the player's body frame (x ahead, y to the right, as the
+// bearings run): the position of the landmark triple (sin, cos, proximity) at `index`, and the
+// ball's velocity (its speed and global direction turned by the body angle). For hand-coded
+// policies that see only features.
+Vec2 body_frame_position(std::span<const float> f, size_t index);
+Vec2 ball_velocity_in_body_frame(std::span<const float> f);
+
 }  // namespace pamdp::hfo

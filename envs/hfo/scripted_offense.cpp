@@ -58,8 +58,7 @@ const ShootingRule& rule_for(ShotAim aim) {
 
 // Position of a landmark triple (sin, cos, proximity) in the agent's body frame.
 Vec2 body_frame(std::span<const float> f, int index) {
-  const double d = proximity_to_distance(f[static_cast<size_t>(index) + 2]);
-  return {d * f[static_cast<size_t>(index) + 1], d * f[static_cast<size_t>(index)]};
+  return body_frame_position(f, static_cast<size_t>(index));
 }
 
 Vec2 unit(Vec2 v) {
@@ -104,13 +103,7 @@ ParamAction ScriptedOffense::kick_against_goalie(std::span<const float> f) {
   const Vec2 post_top = body_frame(f, feat::kGoalPostTop);
   const Vec2 post_bottom = body_frame(f, feat::kGoalPostBottom);
   const Vec2 keeper = body_frame(f, kNumAgentFeatures);
-  // Ball velocity: global direction and speed (max 5.0), turned into the body frame.
-  const double speed = 0.5 * (f[feat::kBallSpeed] + 1.0) * 5.0;
-  const double vgx = speed * f[feat::kBallVelAngleCos];
-  const double vgy = speed * f[feat::kBallVelAngleSin];
-  const double bs = f[feat::kBodySin];
-  const double bc = f[feat::kBodyCos];
-  const Vec2 vb{vgx * bc + vgy * bs, -vgx * bs + vgy * bc};
+  const Vec2 vb = ball_velocity_in_body_frame(f);
 
   // Kick acceleration available here (reference §2.7, without noise).
   const double dist = ball.r();

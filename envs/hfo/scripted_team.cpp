@@ -11,13 +11,6 @@
 namespace pamdp::hfo {
 namespace {
 
-// Position of a landmark triple (sin, cos, proximity) in the player's body frame (x ahead,
-// y to the right, as the features' bearings run).
-Vec2 body_frame(std::span<const float> f, size_t index) {
-  const double d = proximity_to_distance(f[index + 2]);
-  return {d * f[index + 1], d * f[index]};
-}
-
 // A block of another player is all zeros when HFO has no player for the slot (§3.3).
 bool block_present(std::span<const float> f, size_t index) {
   return f[index] != 0.0F || f[index + 1] != 0.0F || f[index + 2] != 0.0F;
@@ -71,28 +64,22 @@ ParamAction ScriptedTeamPlayer::act(std::span<const float> f) {
                  expected, teammates_, opponents_);
     std::abort();
   }
-  const Vec2 ball = body_frame(f, feat::kBallAngleSin);
-  const Vec2 goal = body_frame(f, feat::kGoalCentre);
+  const Vec2 ball = body_frame_position(f, feat::kBallAngleSin);
+  const Vec2 goal = body_frame_position(f, feat::kGoalCentre);
   const size_t first_opponent = kNumAgentFeatures + static_cast<size_t>(kFeaturesPerPlayer * teammates_);
 
   // The nearest opponent (blocks come nearest first).
   const bool opponent = opponents_ > 0 && block_present(f, first_opponent);
-  const Vec2 keeper = opponent ? body_frame(f, first_opponent) : Vec2{};
+  const Vec2 keeper = opponent ? body_frame_position(f, first_opponent) : Vec2{};
 
-  // Ball velocity in the body frame (features give its speed and global direction).
-  const double speed = 0.5 * (f[feat::kBallSpeed] + 1.0) * 5.0;
-  const double vgx = speed * f[feat::kBallVelAngleCos];
-  const double vgy = speed * f[feat::kBallVelAngleSin];
-  const double bs = f[feat::kBodySin];
-  const double bc = f[feat::kBodyCos];
-  const Vec2 vb{vgx * bc + vgy * bs, -vgx * bs + vgy * bc};
+  const Vec2 vb = ball_velocity_in_body_frame(f);
   // Who goes for the ball: this player unless a teammate is nearer to where the ball will be
   // kChaseLookahead cycles from now (so a passer leaves a pass to its receiver).
   const Vec2 ahead = ball + vb * ((1.0 - std::pow(kBallDecay, kChaseLookahead)) / (1.0 - kBallDecay));
   bool chase = true;
   for (int k = 0; k < teammates_; ++k) {
     const size_t block = kNumAgentFeatures + static_cast<size_t>(kFeaturesPerPlayer * k);
-    if (block_present(f, block) && (body_frame(f, block) - ahead).r() < ahead.r() - 0.05) {
+    if (block_present(f, block) && (body_frame_position(f, block) - ahead).r() < ahead.r() - 0.05) {
       chase = false;
     }
   }
@@ -106,7 +93,7 @@ ParamAction ScriptedTeamPlayer::act(std::span<const float> f) {
       if (!block_present(f, block)) {
         continue;
       }
-      const Vec2 m = body_frame(f, block);
+      const Vec2 m = body_frame_position(f, block);
       const double free = (keeper - m).r() - (keeper - ball).r();
       if (free >= kOpenMargin && segment_distance(keeper, ball, m) >= kLaneClearance && free > best) {
         best = free;
