@@ -20,6 +20,9 @@
 #include "actor/exploration.hpp"
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
+#include "envs/hfo/settings.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/greedy_policy.hpp"
@@ -371,6 +374,100 @@ class PyEnv {
   int last_status_ = 0;
 };
 
+// N offense agents in one embedded HFO game (envs/hfo/hfo_team_env.hpp), for python/pamdp's
+// ParallelEnv: one observation, action and reward per agent, in player order.
+class PyTeamEnv {
+ public:
+  PyTeamEnv(const std::string& id, int agents, const Options& options) : config_(resolve_env(id, options)) {
+    if (config_.name != "hfo") {
+      throw py::value_error("a team plays the embedded HFO simulator: give an hfo id (hfo-1v0, hfo-1v1, hfo), got '" +
+                            id + "'");
+    }
+    if (agents < 1 || agents > hfo::kMaxOffenseAgents) {
+      throw py::value_error("agents must be within [1, " + std::to_string(hfo::kMaxOffenseAgents) + "], got " +
+                            std::to_string(agents));
+    }
+    hfo::SoccerSimConfig c = hfo::sim_config(config_.params);
+    c.offense_agents = agents;
+    env_ = std::make_unique<hfo::HfoTeamEnv>(c, config_.params.boolean("shoot_action"),
+                                             static_cast<int>(config_.params.integer("out_of_bounds_penalty")));
+    width_ = static_cast<size_t>(env_->observation_size());
+    obs_.resize(width_ * static_cast<size_t>(agents));
+    rewards_.resize(static_cast<size_t>(agents));
+    actions_.resize(static_cast<size_t>(agents));
+    shared_.assign(static_cast<size_t>(agents),
+                   std::vector<float>(static_cast<size_t>(facts_.space.num_params()), 0.0F));
+  }
+
+  py::list reset(py::handle seed) {
+    if (seed.is_none()) {
+      env_->reset(obs_);
+    } else {
+      env_->reset(read_seed(seed), obs_);
+    }
+    needs_reset_ = false;
+    return observations();
+  }
+
+  // actions: a sequence of one action per agent, in player order (each as PyEnv.step takes
+  // one). Returns (observations, rewards, status name, status code, terminated, truncated).
+  py::tuple step(py::handle actions) {
+    if (needs_reset_) {
+      throw std::logic_error("team env: step() before reset() or after the episode ended; call reset() first");
+    }
+    if (!py::isinstance<py::sequence>(actions) || py::isinstance<py::str>(actions)) {
+      throw py::type_error("actions must be a sequence of one action per agent, got " + type_name(actions));
+    }
+    const auto seq = py::reinterpret_borrow<py::sequence>(actions);
+    if (seq.size() != static_cast<size_t>(env_->agents())) {
+      throw py::value_error("actions: " + std::to_string(seq.size()) + " given, one per agent (" +
+                            std::to_string(env_->agents()) + ") expected");
+    }
+    for (size_t i = 0; i < seq.size(); ++i) {
+      const int id = read_action(seq[i], facts_, shared_[i]);
+      actions_[i] = {id, shared_[i]};
+    }
+    const int status = env_->step(actions_, obs_, rewards_);
+    needs_reset_ = status != hfo::kInGame;
+    py::list rewards;
+    for (float r : rewards_) {
+      rewards.append(static_cast<double>(r));
+    }
+    const bool timeout = status == hfo::kOutOfTime;
+    return py::make_tuple(observations(), rewards, outcome_name(single_, status), status, needs_reset_ && !timeout,
+                          timeout);
+  }
+
+  [[nodiscard]] int agents() const { return env_->agents(); }
+  [[nodiscard]] int observation_size() const { return env_->observation_size(); }
+  [[nodiscard]] int max_episode_steps() const { return env_->max_episode_steps(); }
+  [[nodiscard]] const app::EnvConfig& config() const { return config_; }
+  [[nodiscard]] const ActionSpace& action_space() const { return env_->action_space(); }
+
+ private:
+  py::list observations() const {
+    py::list out;
+    for (int i = 0; i < env_->agents(); ++i) {
+      py::array_t<float> o(static_cast<py::ssize_t>(width_));
+      std::memcpy(o.mutable_data(), obs_.data() + static_cast<size_t>(i) * width_, width_ * sizeof(float));
+      out.append(std::move(o));
+    }
+    return out;
+  }
+
+  app::EnvConfig config_;
+  // Status names and action facts, as the one-agent env has them.
+  hfo::HfoEnv single_{hfo::SoccerSimConfig{}, config_.params.boolean("shoot_action")};
+  EnvFacts facts_{single_};
+  std::unique_ptr<hfo::HfoTeamEnv> env_;
+  size_t width_ = 0;
+  std::vector<float> obs_;
+  std::vector<float> rewards_;
+  std::vector<ParamAction> actions_;
+  std::vector<std::vector<float>> shared_;
+  bool needs_reset_ = true;
+};
+
 class PyVectorEnv {
  public:
   PyVectorEnv(const std::string& id, const Options& options, int num_envs, int num_threads,
@@ -675,6 +772,20 @@ PYBIND11_MODULE(_pamdp, m) {
       .def_property_readonly("actions", [](const PyEnv& e) { return describe_actions(e.env().action_space()); })
       .def_property_readonly("outcomes", [](const PyEnv& e) { return describe_outcomes(e.env()); })
       .def_property_readonly("success_status", [](const PyEnv& e) { return e.env().success_status(); });
+
+  py::class_<PyTeamEnv>(m, "TeamEnv", py::dynamic_attr())
+      .def(py::init([](const std::string& id, int agents, const py::dict& options) {
+             return std::make_unique<PyTeamEnv>(id, agents, to_options(options));
+           }),
+           py::arg("env_id"), py::arg("agents"), py::arg("options"))
+      .def("reset", &PyTeamEnv::reset, py::arg("seed") = py::none())
+      .def("step", &PyTeamEnv::step, py::arg("actions"))
+      .def_property_readonly("env_id", [](const PyTeamEnv& e) { return id_of(e.config()); })
+      .def_property_readonly("num_agents", &PyTeamEnv::agents)
+      .def_property_readonly("observation_size", &PyTeamEnv::observation_size)
+      .def_property_readonly("observation_bound", [](const PyTeamEnv& e) { return observation_bound(e.config()); })
+      .def_property_readonly("max_episode_steps", &PyTeamEnv::max_episode_steps)
+      .def_property_readonly("actions", [](const PyTeamEnv& e) { return describe_actions(e.action_space()); });
 
   py::class_<PyVectorEnv>(m, "VectorEnv", py::dynamic_attr())
       .def(py::init([](const std::string& id, const py::dict& options, int num_envs, int num_threads,

@@ -39,7 +39,7 @@ import numpy as np
 from . import _pamdp
 from . import spaces
 
-__all__ = ["Env", "EnvSpec", "VectorEnv", "Policy", "make", "make_vec", "load_policy", "evaluate", "env_ids",
+__all__ = ["Env", "EnvSpec", "VectorEnv", "ParallelEnv", "Policy", "make", "make_vec", "make_team", "load_policy", "evaluate", "env_ids",
            "spaces"]
 
 
@@ -278,6 +278,101 @@ def _ids_help() -> str:
 
 
 make.__doc__ += _ids_help()
+
+
+class ParallelEnv:
+    """N learned offense players in one embedded HFO game (HFO's --offense-agents N), with
+    PettingZoo's parallel API and no PettingZoo dependency: agents are named "offense_0" ...
+    "offense_{N-1}" (player 0 is the agent of the one-player env), and reset, step, the spaces
+    and the infos are dicts keyed by those names.
+
+        env = pamdp.make_team("hfo-1v1", agents=2)        # 2v1 against agent2d's goalie
+        observations, infos = env.reset(seed=1)
+        while env.agents:
+            actions = {a: env.action_space(a).sample() for a in env.agents}
+            observations, rewards, terminations, truncations, infos = env.step(actions)
+
+    Each player observes its own features (58, then 8 per other player: its teammates nearest
+    first, then its opponents) and earns its own reward (dqn-hfo's, from its own features); the
+    episode ends for all at once, and infos[agent]["outcome"] names how (as Env's info). Actions
+    are Env's: (id, params) per agent. Once an episode ends env.agents is empty until reset()."""
+
+    metadata = {"render_modes": [], "name": "pamdp_hfo_team", "is_parallelizable": True}
+
+    def __init__(self, env_id: str = "hfo-1v1", agents: int = 2, **options):
+        if isinstance(agents, bool) or not isinstance(agents, numbers.Integral):
+            raise TypeError(f"agents must be an int, got {type(agents).__name__}")
+        self._team = _pamdp.TeamEnv(env_id, int(agents), _options(env_id, options))
+        self.possible_agents = [f"offense_{i}" for i in range(self._team.num_agents)]
+        self.agents = []
+        bound = self._team.observation_bound
+        self._observation_space = spaces.Box(-bound, bound, (self._team.observation_size,), np.float32)
+        self._action_space = spaces.action_space(self._team.actions)
+        self.max_episode_steps = self._team.max_episode_steps
+        self.render_mode = None
+
+    @property
+    def num_agents(self) -> int:
+        return len(self.agents)
+
+    @property
+    def max_num_agents(self) -> int:
+        return len(self.possible_agents)
+
+    def _check_agent(self, agent):
+        if agent not in self.possible_agents:
+            raise KeyError(f"no agent {agent!r}: the agents are {self.possible_agents}")
+
+    def observation_space(self, agent):
+        self._check_agent(agent)
+        return self._observation_space
+
+    def action_space(self, agent):
+        self._check_agent(agent)
+        return self._action_space
+
+    def reset(self, seed=None, options=None):
+        if options is not None and not isinstance(options, dict):
+            raise TypeError(f"reset options must be a dict or None, got {type(options).__name__}")
+        if seed is not None:
+            self._action_space.seed(seed)
+        observations = self._team.reset(seed)
+        self.agents = list(self.possible_agents)
+        infos = {a: {"outcome": "IN_GAME", "status": 0} for a in self.agents}
+        return dict(zip(self.agents, observations)), infos
+
+    def step(self, actions):
+        if not self.agents:
+            raise RuntimeError("step() before reset() or after the episode ended; call reset() first")
+        if not isinstance(actions, dict):
+            raise TypeError(f"actions must be a dict keyed by agent name, got {type(actions).__name__}")
+        missing = [a for a in self.agents if a not in actions]
+        extra = [a for a in actions if a not in self.agents]
+        if missing or extra:
+            raise KeyError(f"actions must hold one action for each of {self.agents}"
+                           + (f"; missing {missing}" if missing else "") + (f"; unknown {extra}" if extra else ""))
+        observations, rewards, outcome, status, terminated, truncated = self._team.step(
+            [actions[a] for a in self.agents])
+        names = self.agents
+        infos = {a: {"outcome": outcome, "status": status} for a in names}
+        result = (dict(zip(names, observations)), dict(zip(names, rewards)), {a: terminated for a in names},
+                  {a: truncated for a in names}, infos)
+        if terminated or truncated:
+            self.agents = []
+        return result
+
+    def render(self):
+        return None
+
+    def close(self):
+        pass
+
+
+def make_team(env_id: str = "hfo-1v1", agents: int = 2, **options) -> ParallelEnv:
+    """N offense players in one embedded HFO game with PettingZoo's parallel API (ParallelEnv):
+    make_team("hfo-1v1", agents=2) is 2v1 against agent2d's goalie, make_team("hfo-1v0",
+    agents=2) 2v0; env options as make's keyword arguments."""
+    return ParallelEnv(env_id, agents, **options)
 
 
 def make_vec(env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,
