@@ -4,8 +4,6 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "envs/hfo/hfo_team_env.hpp"
-
 namespace pamdp::hfo {
 namespace {
 
@@ -120,6 +118,26 @@ void HfoEnv::set_state(const PlayerState& agent, const BallState& ball, const Pl
   sim_.set_state(agent, ball);
   sim_.set_goalie(goalie);
   begin_episode(obs);
+}
+
+void play_action(SoccerSim& sim, int player, const ParamAction& action, bool shoot) {
+  if (action.params.size() < static_cast<size_t>(hfo_action_space(shoot).num_params())) {
+    misuse("play_action(): the parameter vector must hold the 6 HFO parameters (8 with env.shoot_action)");
+  }
+  const auto p = [&](int i) { return static_cast<double>(action.params[static_cast<size_t>(i)]); };
+  switch (action.id) {
+    case kDash: sim.dash_player(player, p(param::kDashPower), p(param::kDashDir)); break;
+    case kTurn: sim.turn_player(player, p(param::kTurnDir)); break;
+    case kTackle: sim.tackle_player(player, p(param::kTackleDir)); break;
+    case kKick: sim.kick_player(player, p(param::kKickPower), p(param::kKickDir)); break;
+    case kShoot:
+      if (!shoot) {
+        misuse("play_action(): SHOOT (4) needs env.shoot_action");
+      }
+      sim.kick_player(player, p(param::kShootPower), p(param::kShootDir));
+      break;
+    default: misuse("play_action(): action id out of range (0 DASH, 1 TURN, 2 TACKLE, 3 KICK, 4 SHOOT)");
+  }
 }
 
 StepResult HfoEnv::step(const ParamAction& action, std::span<float> obs) {

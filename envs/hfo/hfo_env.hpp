@@ -66,6 +66,12 @@ class ShapedReward {
   bool got_kick_ = false;
 };
 
+// Plays offense player `player`'s action through the simulator's client: the one place the
+// action ids map to commands (SHOOT is a KICK with its own parameters and needs `shoot`), for
+// HfoEnv and HfoTeamEnv alike. A bad id or short parameter vector stops the process
+// (programming error).
+void play_action(SoccerSim& sim, int player, const ParamAction& action, bool shoot);
+
 class HfoEnv final : public Env {
  public:
   // shoot_action: the action space with SHOOT (env.shoot_action); out_of_bounds_penalty: the

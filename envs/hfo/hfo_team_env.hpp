@@ -19,11 +19,6 @@
 
 namespace pamdp::hfo {
 
-// Plays one player's action through the simulator's client (HfoEnv's rules: SHOOT is a KICK
-// with its own parameters and needs `shoot`). A bad id or short parameter vector stops the
-// process (programming error).
-void play_action(SoccerSim& sim, int player, const ParamAction& action, bool shoot);
-
 class HfoTeamEnv {
  public:
   // config.offense_agents is N (1-4; SoccerSim throws std::invalid_argument otherwise).
