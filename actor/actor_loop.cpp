@@ -85,15 +85,40 @@ class OutgoingBatch {
   std::vector<uint8_t> terminals_;
 };
 
+// A team game's teachers, one per player (none without demonstrations).
+std::vector<std::unique_ptr<Policy>> make_teachers(const Env& env,
+                                                   const std::function<std::unique_ptr<Policy>()>& make) {
+  std::vector<std::unique_ptr<Policy>> out;
+  if (make) {
+    for (int i = 0; i < env.agents(); ++i) {
+      out.push_back(make());
+    }
+  }
+  return out;
+}
+
+std::vector<Policy*> pointers(const std::vector<std::unique_ptr<Policy>>& v) {
+  std::vector<Policy*> out;
+  for (const auto& p : v) {
+    out.push_back(p.get());
+  }
+  return out;
+}
+
 struct EnvSlot {
   std::unique_ptr<Env> env;
-  std::unique_ptr<Policy> teacher;  // with demonstrations
-  EpisodePlayer player;             // its episodes, played as `pamdp train` plays them
+  std::vector<std::unique_ptr<Policy>> teachers;  // with demonstrations, one per player
+  std::vector<Policy*> teacher_ptrs;
+  EpisodePlayer player;  // its episodes, played as `pamdp train` plays them
   uint64_t seed = 0;
   uint64_t episodes = 0;
 
-  EnvSlot(std::unique_ptr<Env> e, std::unique_ptr<Policy> t, bool labels, uint64_t s)
-      : env(std::move(e)), teacher(std::move(t)), player(*env, teacher.get(), labels), seed(s) {}
+  EnvSlot(std::unique_ptr<Env> e, const std::function<std::unique_ptr<Policy>()>& make_teacher, bool labels, uint64_t s)
+      : env(std::move(e)),
+        teachers(make_teachers(*env, make_teacher)),
+        teacher_ptrs(pointers(teachers)),
+        player(*env, teacher_ptrs, labels),
+        seed(s) {}
 };
 
 // The sequences of the batches sent to one shard and not yet acknowledged, oldest first: a ring
@@ -152,8 +177,8 @@ const Env& first_env(const std::vector<std::unique_ptr<Env>>& envs) {
   for (const auto& e : envs) {
     if (e == nullptr || e->observation_size() != first.observation_size() ||
         e->action_space().output_width() != first.action_space().output_width() ||
-        e->action_space().num_actions() != first.action_space().num_actions()) {
-      throw std::invalid_argument("ActorLoop: every env must have the same observation size and action space");
+        e->action_space().num_actions() != first.action_space().num_actions() || e->agents() != first.agents()) {
+      throw std::invalid_argument("ActorLoop: every env must have the same observation size, action space and players");
     }
   }
   if (first.max_episode_steps() < 1) {
@@ -294,8 +319,8 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
   const uint64_t actor_seed = mix_seeds(config.seed, 2000 + uint64_t{actor_index});
   envs.reserve(env_list.size());
   for (size_t k = 0; k < env_list.size(); ++k) {
-    envs.emplace_back(std::move(env_list[k]), config.make_teacher ? config.make_teacher() : nullptr,
-                      config.exploration.demo_relabel, mix_seeds(actor_seed, k));
+    envs.emplace_back(std::move(env_list[k]), config.make_teacher, config.exploration.demo_relabel,
+                      mix_seeds(actor_seed, k));
   }
   if (config.demo_table) {
     demo_batch.emplace(config.batch_transitions, obs_dim, width);
@@ -359,7 +384,8 @@ void ActorLoop::Impl::reset(EnvSlot& slot) {
 
 void ActorLoop::Impl::step(EnvSlot& slot) {
   const StepResult sr = slot.player.step(act, explore, eps);
-  counters.env_steps.fetch_add(1, std::memory_order_relaxed);
+  // One decision per player: a team's cycle is agents() steps.
+  counters.env_steps.fetch_add(slot.player.players(), std::memory_order_relaxed);
   if (slot.player.ended()) {
     finish_episode(slot, sr.status);
   }
@@ -368,15 +394,18 @@ void ActorLoop::Impl::step(EnvSlot& slot) {
 void ActorLoop::Impl::finish_episode(EnvSlot& slot, int status) {
   // The last step is terminal, time-outs included, as in the paper's code and `pamdp train`.
   // Returns are computed once per buffer; a demonstration's rows go to both tables.
+  // A team's players each send their own episode.
   EpisodePlayer& p = slot.player;
-  p.episode().compute_returns(config.gamma);
-  add_rows(p.episode(), batch, wire::kReplayTable);
-  if (p.demo() && demo_batch) {
-    add_rows(p.episode(), *demo_batch, wire::kDemoTable);
-  }
-  if (EpisodeBuffer* labels = p.labels()) {
-    labels->compute_returns(config.gamma);
-    add_rows(*labels, *demo_batch, wire::kDemoTable);
+  for (int i = 0; i < p.players(); ++i) {
+    p.episode(i).compute_returns(config.gamma);
+    add_rows(p.episode(i), batch, wire::kReplayTable);
+    if (p.demo() && demo_batch) {
+      add_rows(p.episode(i), *demo_batch, wire::kDemoTable);
+    }
+    if (EpisodeBuffer* labels = p.labels(i)) {
+      labels->compute_returns(config.gamma);
+      add_rows(*labels, *demo_batch, wire::kDemoTable);
+    }
   }
   // The ended episode goes out now, in a partial batch if need be, as `pamdp train` puts each
   // episode into its replay when it ends. Held back until a batch filled, the rows of episodes a

@@ -69,10 +69,10 @@ struct ActorLoopConfig {
   int tick_ms = 1000;         // on_tick period
   std::optional<net::CurveClientKeys> curve;
   // With exploration.demo_fraction > 0: makes the teacher that plays the demonstrations, one per
-  // env. An episode is a demonstration with probability demo_share(updates, demo_fraction,
-  // demo_anneal_updates, demo_fraction_end), drawn at its start as `pamdp train` draws it; its
-  // transitions go to the shards like the agent's, and its EpisodeReport says `scripted`
-  // (weights version 0).
+  // env and player (a team game takes Env::agents() of them). An episode is a demonstration with probability
+  // demo_share(updates, demo_fraction, demo_anneal_updates, demo_fraction_end), drawn at its start as `pamdp train`
+  // draws it; its transitions go to the shards like the agent's, and its EpisodeReport says `scripted` (weights version
+  // 0).
   std::function<std::unique_ptr<Policy>()> make_teacher;
   // Cloning (ddpg.demo_bc_weight > 0): a demonstration's rows also go to the shards'
   // demonstration table (TransitionBatch.table = 1), as `pamdp train` keeps them in a second

@@ -1,69 +1,114 @@
 #include "actor/episode_player.hpp"
 
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace pamdp {
 
 EpisodePlayer::EpisodePlayer(Env& env, Policy* teacher, bool labels)
-    : env_(env),
-      teacher_(teacher),
-      space_(env.action_space()),
-      episode_(env.max_episode_steps(), env.observation_size(), space_.output_width()),
-      obs_(static_cast<size_t>(env.observation_size())),
-      next_obs_(obs_.size()),
-      net_out_(static_cast<size_t>(space_.output_width())),
-      stored_(net_out_.size()) {
+    : EpisodePlayer(env, teacher == nullptr ? std::span<Policy* const>{} : std::span<Policy* const>(&teacher, 1),
+                    labels) {}
+
+EpisodePlayer::EpisodePlayer(Env& env, std::span<Policy* const> teachers, bool labels)
+    : env_(env), teachers_(teachers.begin(), teachers.end()), space_(env.action_space()) {
+  const auto n = static_cast<size_t>(env.agents());
+  if (n < 1) {
+    throw std::invalid_argument("EpisodePlayer: an env with no players");
+  }
+  if (!teachers_.empty() && teachers_.size() != n) {
+    throw std::invalid_argument("EpisodePlayer: " + std::to_string(teachers_.size()) + " teachers for " +
+                                std::to_string(n) + " players; give one per player");
+  }
+  for (size_t i = 0; i < n; ++i) {
+    episodes_.emplace_back(env.max_episode_steps(), env.observation_size(), space_.output_width());
+  }
+  const auto obs = static_cast<size_t>(env.observation_size());
+  const auto width = static_cast<size_t>(space_.output_width());
+  obs_.resize(n * obs);
+  next_obs_.resize(obs_.size());
+  net_out_.resize(n * width);
+  stored_.resize(net_out_.size());
+  actions_.resize(n);
+  rewards_.resize(n);
   if (labels) {
-    if (teacher == nullptr) {
+    if (teachers_.empty()) {
       throw std::invalid_argument("EpisodePlayer: labels need a teacher");
     }
-    labels_.emplace(env.max_episode_steps(), env.observation_size(), space_.output_width());
+    for (size_t i = 0; i < n; ++i) {
+      labels_.emplace_back(env.max_episode_steps(), env.observation_size(), space_.output_width());
+    }
     label_out_.resize(net_out_.size());
   }
 }
 
 void EpisodePlayer::begin(uint64_t env_seed, double demo_share, Rng& rng) {
   env_.reset(env_seed, obs_);
-  episode_.clear();
+  for (EpisodeBuffer& e : episodes_) {
+    e.clear();
+  }
   return_ = 0.0F;
   steps_ = 0;
   ended_ = false;
   demo_ = demo_share > 0.0 && rng.uniform() < demo_share;
-  if (demo_ && teacher_ == nullptr) {
+  if (demo_ && teachers_.empty()) {
     throw std::logic_error("EpisodePlayer: a demonstration share > 0 without a teacher");
   }
-  label_ = labels_.has_value() && !demo_;
+  label_ = !labels_.empty() && !demo_;
   if (label_) {
-    labels_->clear();
+    for (EpisodeBuffer& l : labels_) {
+      l.clear();
+    }
   }
   if (demo_ || label_) {
-    teacher_->begin_episode();
+    for (Policy* t : teachers_) {
+      t->begin_episode();
+    }
   }
 }
 
 StepResult EpisodePlayer::step(const Act& act, EpsilonGreedy& explore, double epsilon) {
-  // The network's output is computed only where it is used: by a greedy step, as a random step's
-  // parameters (exploration.uniform_random_params off), or as the parameters of the actions a
-  // teacher did not take.
-  if (act && (demo_ || label_ || explore.uses_output(epsilon))) {
-    act(obs_, net_out_);
+  const auto n = episodes_.size();
+  const auto obs_dim = obs_.size() / n;
+  const auto width = net_out_.size() / n;
+  const auto num_actions = static_cast<size_t>(space_.num_actions());
+  const std::span<const float> obs_all(obs_);
+  const std::span<float> out_all(net_out_);
+  const std::span<float> stored_all(stored_);
+  for (size_t i = 0; i < n; ++i) {
+    const auto obs = obs_all.subspan(i * obs_dim, obs_dim);
+    const auto out = out_all.subspan(i * width, width);
+    const auto stored = stored_all.subspan(i * width, width);
+    // The network's output is computed only where it is used: by a greedy step, as a random
+    // step's parameters (exploration.uniform_random_params off), or as the parameters of the
+    // actions a teacher did not take.
+    if (act && (demo_ || label_ || explore.uses_output(epsilon))) {
+      act(obs, out);
+    }
+    const int id = demo_ ? write_teacher_output(space_, teachers_[i]->act(obs), out, stored)
+                         : explore.select(obs, out, epsilon, stored);
+    if (label_) {  // before the step: the label is for the state the agent acted in
+      write_teacher_output(space_, teachers_[i]->act(obs), out, std::span<float>(label_out_).subspan(i * width, width));
+    }
+    actions_[i] = {id, std::span<const float>(stored).subspan(num_actions)};
   }
-  const int id = demo_ ? write_teacher_output(space_, teacher_->act(obs_), net_out_, stored_)
-                       : explore.select(obs_, net_out_, epsilon, stored_);
-  if (label_) {  // before the step: the label is for the state the agent acted in
-    write_teacher_output(space_, teacher_->act(obs_), net_out_, label_out_);
+  const StepResult sr = n == 1 ? env_.step(actions_[0], next_obs_) : env_.step_team(actions_, next_obs_, rewards_);
+  if (n == 1) {
+    rewards_[0] = sr.reward;
   }
-  const size_t num_actions = static_cast<size_t>(space_.num_actions());
-  const StepResult sr = env_.step({id, std::span<const float>(stored_).subspan(num_actions)}, next_obs_);
-  episode_.push(obs_, stored_, sr.reward, next_obs_);
-  if (label_) {
-    labels_->push(obs_, label_out_, sr.reward, next_obs_);
+  const std::span<const float> next_all(next_obs_);
+  for (size_t i = 0; i < n; ++i) {
+    const auto obs = obs_all.subspan(i * obs_dim, obs_dim);
+    const auto next = next_all.subspan(i * obs_dim, obs_dim);
+    episodes_[i].push(obs, stored_all.subspan(i * width, width), rewards_[i], next);
+    if (label_) {
+      labels_[i].push(obs, std::span<const float>(label_out_).subspan(i * width, width), rewards_[i], next);
+    }
   }
   return_ += sr.reward;
   ++steps_;
   std::swap(obs_, next_obs_);
-  ended_ = sr.terminal() || episode_.size() >= episode_.capacity();
+  ended_ = sr.terminal() || episodes_[0].size() >= episodes_[0].capacity();
   return sr;
 }
 

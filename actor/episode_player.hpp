@@ -6,6 +6,12 @@
 // keeps the transition. Where an ended episode goes (a replay buffer, batches for the shards) is
 // the caller's: it reads episode() and labels() once ended() says so.
 //
+// A team game (env.agents() = n > 1) is played the same way, player by player: each acts on its
+// own observation through the same acting policy (parameter sharing), explores on its own draws,
+// and keeps its own episode (episode(i), labels(i)); a demonstration is the teachers' (one per
+// player), and the episode's return is the players' mean. With n = 1 nothing changes: the same
+// draws, the same env calls.
+//
 // step() allocates nothing. The env and the teacher are the caller's and must outlive the player.
 #pragma once
 
@@ -32,6 +38,9 @@ class EpisodePlayer {
   // teacher: the scripted policy that plays demonstrations and labels (nullptr: none). labels:
   // keep the teacher's label of each of the agent's steps (needs a teacher).
   EpisodePlayer(Env& env, Policy* teacher, bool labels);
+  // For a team: `teachers` is empty (none) or holds one per player (std::invalid_argument
+  // otherwise).
+  EpisodePlayer(Env& env, std::span<Policy* const> teachers, bool labels);
 
   // Resets the env with env_seed and starts an episode, played by the teacher with probability
   // demo_share. The draw comes from rng only when demo_share > 0, so runs without
@@ -43,21 +52,27 @@ class EpisodePlayer {
   StepResult step(const Act& act, EpsilonGreedy& explore, double epsilon);
 
   [[nodiscard]] bool ended() const { return ended_; }
-  // This episode's steps; the last is terminal once it has ended.
-  [[nodiscard]] EpisodeBuffer& episode() { return episode_; }
+  // The players of the game (env.agents()).
+  [[nodiscard]] int players() const { return static_cast<int>(episodes_.size()); }
+  // Player `i`'s steps this episode; the last is terminal once it has ended.
+  [[nodiscard]] EpisodeBuffer& episode(int i = 0) { return episodes_[static_cast<size_t>(i)]; }
   // The same states with the teacher's actions, when this episode is labelled; else nullptr.
-  [[nodiscard]] EpisodeBuffer* labels() { return label_ ? &*labels_ : nullptr; }
+  [[nodiscard]] EpisodeBuffer* labels(int i = 0) { return label_ ? &labels_[static_cast<size_t>(i)] : nullptr; }
   [[nodiscard]] bool demo() const { return demo_; }
+  // The undiscounted return; of a team, the players' mean.
   [[nodiscard]] float episode_return() const { return return_; }
   [[nodiscard]] int steps() const { return steps_; }
 
  private:
   Env& env_;
-  Policy* teacher_;
+  std::vector<Policy*> teachers_;
   const ActionSpace& space_;
-  EpisodeBuffer episode_;
-  std::optional<EpisodeBuffer> labels_;
+  std::vector<EpisodeBuffer> episodes_;
+  std::vector<EpisodeBuffer> labels_;  // one per player when labelling, else empty
+  // Player-major: player i's observation at [i * obs, (i + 1) * obs), its output at [i * width, ...).
   std::vector<float> obs_, next_obs_, net_out_, stored_, label_out_;
+  std::vector<ParamAction> actions_;
+  std::vector<float> rewards_;
   bool demo_ = false;   // the teacher plays this episode
   bool label_ = false;  // the agent plays it and the teacher labels its steps
   bool ended_ = false;

@@ -130,11 +130,7 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.curve = curve;
   if (config.exploration.demo_fraction > 0.0) {
     // The learner's config was checked: demonstrations come with an env the scripted offense reads.
-    const hfo::ShotAim shot = config.demo_shot;
-    const bool shoot_action = hfo::shoot_action(config.env.params);
-    loop_config.make_teacher = [shot, shoot_action] {
-      return std::make_unique<hfo::ScriptedOffense>(shot, shoot_action);
-    };
+    loop_config.make_teacher = [config] { return make_teacher(config); };
   }
   loop_config.demo_table = config.ddpg.demo_bc_weight > 0.0;
 

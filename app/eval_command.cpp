@@ -54,12 +54,14 @@ struct EvalOptions {
 // does (how often it kicks, from where it shoots) without a debugger.
 class TraceCsv {
  public:
-  TraceCsv(const std::string& path, const Env& env) : file_(std::fopen(path.c_str(), "w")), env_(env) {
+  TraceCsv(const std::string& path, const Env& env)
+      : file_(std::fopen(path.c_str(), "w")), env_(env), team_(env.agents() > 1) {
     if (file_ == nullptr) {
       throw std::runtime_error("--trace " + path + ": cannot create the file (" + std::strerror(errno) +
                                "); give a path in a writable directory");
     }
-    std::fprintf(file_, "episode,step,action");
+    // A team game's rows say whose step each is, each player's in turn.
+    std::fprintf(file_, team_ ? "episode,step,player,action" : "episode,step,action");
     for (const ParamSpec& p : env.action_space().params) {
       std::fprintf(file_, ",%s", p.name.c_str());
     }
@@ -75,7 +77,11 @@ class TraceCsv {
 
   void write(const EvalStep& s) {
     const std::string& action = env_.action_space().actions[static_cast<size_t>(s.action.id)].name;
-    std::fprintf(file_, "%d,%d,%s", s.episode, s.step, action.c_str());
+    if (team_) {
+      std::fprintf(file_, "%d,%d,%d,%s", s.episode, s.step, s.player, action.c_str());
+    } else {
+      std::fprintf(file_, "%d,%d,%s", s.episode, s.step, action.c_str());
+    }
     for (float p : s.action.params) {
       std::fprintf(file_, ",%.6g", p);
     }
@@ -90,6 +96,7 @@ class TraceCsv {
  private:
   std::FILE* file_;
   const Env& env_;
+  bool team_;
 };
 
 // `--agreement`: the teacher plays; the student is asked the same question at every step, and
@@ -165,10 +172,11 @@ void print_result(const std::string& name, const EvalResult& r, bool json, const
   }
 }
 
-// Plays the episodes with a progress bar on stderr (only on a terminal), then gives the env back
+// Plays the episodes (a team game: `players` holds one policy for all, or one per player) with a
+// progress bar on stderr (only on a terminal), then gives the env back
 // (a real server's client prints as it leaves, which must come before the table) and reports
 // the pace on stderr (stdout stays the same for the same seed).
-EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, const EvalOptions& o) {
+EvalResult evaluate_with_progress(std::unique_ptr<Env> env, std::span<Policy* const> players, const EvalOptions& o) {
   ProgressBar bar("episodes", o.episodes);
   std::optional<TraceCsv> trace;
   std::function<void(const EvalStep&)> on_step;
@@ -178,7 +186,7 @@ EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, cons
   }
   const auto start = std::chrono::steady_clock::now();
   EvalResult r = evaluate(
-      *env, policy, o.episodes, o.seed, [&bar](int done) { bar.update(done); }, on_step);
+      *env, players, o.episodes, o.seed, [&bar](int done) { bar.update(done); }, on_step);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   bar.finish();
   const std::string env_name(env->name());
@@ -187,6 +195,11 @@ EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, cons
   std::fprintf(stderr, "eval: env %s, %.0f steps in %.1f s (%.0f steps/s)\n", env_name.c_str(), steps, seconds,
                seconds > 0.0 ? steps / seconds : 0.0);
   return r;
+}
+
+EvalResult evaluate_with_progress(std::unique_ptr<Env> env, Policy& policy, const EvalOptions& o) {
+  Policy* one = &policy;
+  return evaluate_with_progress(std::move(env), std::span<Policy* const>(&one, 1), o);
 }
 
 // The simulator flags and the env.* keys they set. An env that does not read one (hfo-server: the
@@ -284,6 +297,11 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
                  o.checkpoint.c_str(), c.ddpg.actor_average_tau);
   }
   GreedyActorPolicy policy(*algorithm, env->action_space(), resolve_exploration(c, env->action_space()), copy);
+  if (o.agreement && env->agents() > 1) {
+    throw std::runtime_error("--agreement compares one striker with the scripted offense; " + o.checkpoint +
+                             " plays a team (env.offense_agents = " + std::to_string(env->agents()) +
+                             "): leave out --agreement");
+  }
   if (o.agreement) {
     if (!gives_embedded_features(c.env)) {
       throw std::runtime_error("--agreement: the scripted offense plays and reads the embedded simulator's features; " +
@@ -300,14 +318,19 @@ void run_checkpoint_eval(const EvalOptions& o, const CLI::App& cmd) {
   print_result(std::string(algorithm->name()), evaluate_with_progress(std::move(env), policy, o), o.json);
 }
 
-// --offense-agents N: N players in one embedded game (HfoTeamEnv), the scripted team player or
-// the paper's random draw in every slot. The row is the team's: its scoring rate and steps to
-// goal; the return is the mean of the players' returns.
+// --offense-agents N: N players in one embedded game (env.offense_agents = N), the scripted team
+// player or the paper's random draw in every slot. The row is the team's: its scoring rate and
+// steps to goal; the return is the mean of the players' returns.
 void run_team_eval(const EvalOptions& o, const CLI::App& cmd) {
-  if (!o.checkpoint.empty() || !o.trace.empty() || o.agreement || cmd.count("--shot") > 0 || cmd.count("--actor") > 0) {
+  if (!o.checkpoint.empty()) {
     throw std::runtime_error(
-        "--offense-agents plays a team of scripted or random players; --checkpoint, --trace, --agreement, --shot "
-        "and --actor are for one agent: leave them out, or leave out --offense-agents");
+        "--offense-agents: a checkpoint plays the team it was trained in (env.offense_agents in "
+        "its config); leave out --offense-agents");
+  }
+  if (!o.trace.empty() || o.agreement || cmd.count("--shot") > 0 || cmd.count("--actor") > 0) {
+    throw std::runtime_error(
+        "--offense-agents plays a team of scripted or random players; --trace, --agreement, --shot and --actor are "
+        "for one agent: leave them out, or leave out --offense-agents");
   }
   if (!o.env.empty() && o.env != "hfo") {
     throw std::runtime_error(
@@ -315,75 +338,32 @@ void run_team_eval(const EvalOptions& o, const CLI::App& cmd) {
         "process of its own: --env hfo-server --set env.offense_agents=" +
         std::to_string(o.offense_agents) + " in each");
   }
-  if (!o.sets.empty()) {
-    throw std::runtime_error(
-        "--set changes one agent's env; with --offense-agents use the simulator flags "
-        "(--goalie, --start, --no-noise, ...)");
-  }
+  ExperimentConfig c;
+  c.env.name = "hfo";
   hfo::SoccerSimConfig cfg = o.sim.resolved();
   cfg.offense_agents = o.offense_agents;
-  hfo::HfoTeamEnv env(cfg);
-  const int n = env.agents();
-  const auto width = static_cast<size_t>(env.observation_size());
+  hfo::set_sim_config(c.env.params, cfg);
+  c = with_env_overrides(c, o.sets);
+  if (c.env.params.integer("offense_agents") != o.offense_agents) {
+    throw std::runtime_error("--set env.offense_agents and --offense-agents disagree: give one of them");
+  }
+  auto env = make_env(c.env);
+  const int n = env->agents();
   std::vector<std::unique_ptr<Policy>> players;
+  std::vector<Policy*> slots;
   for (int i = 0; i < n; ++i) {
     if (o.policy == "scripted") {
-      players.push_back(std::make_unique<hfo::ScriptedTeamPlayer>(n - 1, cfg.goalie ? 1 : 0));
+      players.push_back(std::make_unique<hfo::ScriptedTeamPlayer>(n - 1, c.env.params.boolean("goalie") ? 1 : 0,
+                                                                  hfo::shoot_action(c.env.params)));
     } else {
-      auto random = std::make_unique<RandomPolicy>(env.action_space(), (o.seed ^ 0x5eedULL) + static_cast<uint64_t>(i),
+      auto random = std::make_unique<RandomPolicy>(env->action_space(), (o.seed ^ 0x5eedULL) + static_cast<uint64_t>(i),
                                                    std::vector<int>{hfo::kDash, hfo::kTurn, hfo::kKick});
       random->set_param_range(hfo::param::kDashPower, -100.0F, 100.0F);
       players.push_back(std::move(random));
     }
+    slots.push_back(players.back().get());
   }
-  std::vector<float> obs(width * static_cast<size_t>(n));
-  std::vector<float> rewards(static_cast<size_t>(n));
-  std::vector<ParamAction> actions(static_cast<size_t>(n));
-  EvalResult r;
-  for (const char* name : {"GOAL", "CAPTURED_BY_DEFENSE", "OUT_OF_BOUNDS", "OUT_OF_TIME"}) {
-    r.outcomes[name] = 0;
-  }
-  ProgressBar bar("episodes", o.episodes);
-  double total_return = 0.0;
-  double total_steps = 0.0;
-  double steps_to_goal = 0.0;
-  int goals = 0;
-  env.reset(o.seed, obs);
-  for (int e = 0; e < o.episodes; ++e) {
-    if (e > 0) {
-      env.reset(obs);
-    }
-    for (auto& p : players) {
-      p->begin_episode();
-    }
-    int status = hfo::kInGame;
-    int steps = 0;
-    while (status == hfo::kInGame) {
-      for (int i = 0; i < n; ++i) {
-        actions[static_cast<size_t>(i)] = players[static_cast<size_t>(i)]->act(
-            std::span<const float>(obs).subspan(static_cast<size_t>(i) * width, width));
-      }
-      status = env.step(actions, obs, rewards);
-      ++steps;
-      for (float reward : rewards) {
-        total_return += reward / n;
-      }
-    }
-    ++r.outcomes[hfo::status_name(status)];
-    total_steps += steps;
-    if (status == hfo::kGoal) {
-      ++goals;
-      steps_to_goal += steps;
-    }
-    bar.update(e + 1);
-  }
-  bar.finish();
-  r.episodes = o.episodes;
-  r.goal_rate = static_cast<double>(goals) / o.episodes;
-  r.avg_steps_to_goal = goals > 0 ? steps_to_goal / goals : 0.0;
-  r.avg_return = total_return / o.episodes;
-  r.avg_steps = total_steps / o.episodes;
-  print_result(o.policy + " team of " + std::to_string(n), r, o.json);
+  print_result(o.policy + " team of " + std::to_string(n), evaluate_with_progress(std::move(env), slots, o), o.json);
 }
 
 void run_eval(const EvalOptions& o, const CLI::App& cmd) {

@@ -34,6 +34,24 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The teachers of demonstrations and labels, one per player (the config check refuses
+// demonstrations on an env whose features they cannot read).
+std::vector<std::unique_ptr<Policy>> make_teachers(const ExperimentConfig& c, const Env& env) {
+  std::vector<std::unique_ptr<Policy>> out;
+  for (int i = 0; i < env.agents(); ++i) {
+    out.push_back(make_teacher(c));
+  }
+  return out;
+}
+
+std::vector<Policy*> pointers(const std::vector<std::unique_ptr<Policy>>& v) {
+  std::vector<Policy*> out;
+  for (const auto& p : v) {
+    out.push_back(p.get());
+  }
+  return out;
+}
+
 class Trainer {
  public:
   Trainer(const ExperimentConfig& c, TrainOptions o)
@@ -48,9 +66,10 @@ class Trainer {
         algorithm_(make_learner(c, obs_dim_, space_, mix_seeds(c.seed, 1))),
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
-        demo_(c.demo_shot, hfo::shoot_action(c.env.params)),
+        teachers_(make_teachers(c, *env_)),
+        teacher_ptrs_(pointers(teachers_)),
         sample_rng_(mix_seeds(c.seed, 3)),
-        player_(*env_, &demo_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
+        player_(*env_, teacher_ptrs_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
         act_([this](std::span<const float> obs, std::span<float> out) { algorithm_->act(obs, out); }),
         run_(run_spec(c, o_.run_dir, exploration_, algorithm_->clones_demonstrations()), *algorithm_, *env_,
              *eval_env_) {
@@ -101,7 +120,10 @@ class Trainer {
   // kept for cloning (the demonstrations also go into replay_).
   std::optional<ReplayBuffer> demo_replay_;
   EpsilonGreedy explore_;
-  hfo::ScriptedOffense demo_;  // plays exploration.demo_fraction of the episodes, labels with demo_relabel
+  // The scripted offense (one per player of a team) plays exploration.demo_fraction of the
+  // episodes and labels with demo_relabel.
+  std::vector<std::unique_ptr<Policy>> teachers_;
+  std::vector<Policy*> teacher_ptrs_;
   Rng sample_rng_;
   std::optional<LocalSampler> sampler_;  // the updates' minibatches: replay_, and demo_replay_ to clone
   EpisodePlayer player_;                 // the episodes, played as the actors play them
@@ -221,12 +243,15 @@ TrainSummary Trainer::run() {
       const double eps = linear_epsilon(algorithm_->updates(), exploration_.epsilon_start, exploration_.epsilon_end,
                                         exploration_.epsilon_anneal_updates);
       status = player_.step(act_, explore_, eps).status;
-      run_.record_env_steps(1);
+      // A team's cycle is one decision step per player, each a transition.
+      run_.record_env_steps(player_.players());
       if (o_.metrics != nullptr) {
-        o_.metrics->on_step(eps);
+        for (int i = 0; i < player_.players(); ++i) {
+          o_.metrics->on_step(eps);
+        }
       }
 
-      update_credit_ += c_.train.updates_per_step;
+      update_credit_ += c_.train.updates_per_step * player_.players();
       // Limits are checked at episode ends only (see should_stop), so a run stopped by a signal,
       // train.max_seconds or train.max_episodes and resumed passes through exactly the states of
       // a run that never stopped. train.max_updates is a count, not a time: no update past it,
@@ -247,9 +272,11 @@ TrainSummary Trainer::run() {
     } while (!player_.ended());
 
     const bool demo = player_.demo();
-    flush_episode(player_.episode(), c_.ddpg.gamma, replay_, demo && demo_replay_ ? &*demo_replay_ : nullptr);
-    if (EpisodeBuffer* labels = player_.labels()) {
-      flush_episode(*labels, c_.ddpg.gamma, *demo_replay_);
+    for (int i = 0; i < player_.players(); ++i) {  // a team's players, each its own episode
+      flush_episode(player_.episode(i), c_.ddpg.gamma, replay_, demo && demo_replay_ ? &*demo_replay_ : nullptr);
+      if (EpisodeBuffer* labels = player_.labels(i)) {
+        flush_episode(*labels, c_.ddpg.gamma, *demo_replay_);
+      }
     }
     algorithm_->sync_acting();
     if (o_.metrics != nullptr) {

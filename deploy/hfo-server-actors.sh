@@ -6,7 +6,12 @@
 #
 #   deploy/hfo-server-actors.sh --hfo-root DIR --join tcp://LEARNER:5555 [--actors N]
 #                               [--base-port P] [--seed S] [--log-dir DIR] [--goalie]
-#                               [--curve-keys DIR | --insecure]
+#                               [--offense-agents M] [--curve-keys DIR | --insecure]
+#
+# A team game (--offense-agents M, 1-4): each server runs bin/HFO --offense-agents M and M actors
+# join it, one per player (actor i's players are logged as actor-i-k.log); the server plays them
+# in lockstep, and if any of them stops the M actors and their server are restarted together. The
+# learner then needs env.offense_agents=M, so that each player's features hold its teammates.
 #
 # Defaults: 1 actor, base port 7000, seed 1 (server i of restart r: S + 100 i + r), logs in
 # runs/hfo-servers. The learner runs with --set env.name=hfo-server (and train.eval_episodes=0,
@@ -27,9 +32,10 @@ base_port=7000
 seed=1
 log_dir=runs/hfo-servers
 goalie=0
+agents=1
 security=()
 
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 die() { echo "hfo-server-actors: $*" >&2; exit 2; }
 need_value() { [[ $# -ge 2 && -n $2 ]] || die "$1 needs a value (see --help)"; }
 
@@ -42,6 +48,7 @@ while [[ $# -gt 0 ]]; do
     --seed) need_value "$@"; seed=$2; shift 2 ;;
     --log-dir) need_value "$@"; log_dir=$2; shift 2 ;;
     --goalie) goalie=1; shift ;;
+    --offense-agents) need_value "$@"; agents=$2; shift 2 ;;
     --curve-keys) need_value "$@"; security=(--curve-keys "$2"); shift 2 ;;
     --insecure) security=(--insecure); shift ;;
     -h|--help) usage; exit 0 ;;
@@ -56,6 +63,7 @@ hfo_root=$(cd "$hfo_root" 2>/dev/null && pwd) || die "--hfo-root: no such direct
 [[ $base_port =~ ^[0-9]+$ && $base_port -ge 1024 && $((base_port + 10 * actors)) -le 65535 ]] ||
   die "--base-port must leave room for $actors servers 10 ports apart below 65536, got '$base_port'"
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, got '$seed'"
+[[ $agents =~ ^[1-4]$ ]] || die "--offense-agents must be 1 to 4 (HFO's learned attackers per server), got '$agents'"
 if [[ ${security[0]:-} == --curve-keys ]]; then
   [[ -f ${security[1]}/client.keys ]] ||
     die "--curve-keys: no client.keys in '${security[1]}' (make the keys with pamdp keygen, and give the directory holding client.keys)"
@@ -77,29 +85,42 @@ log_dir=$(cd "$log_dir" && pwd)  # servers run there: rcssserver writes its defa
 defense=()
 ((goalie == 0)) || defense=(--defense-npcs 1)
 
-# One actor and its server, restarted together until this subshell is told to stop.
+# One server and its actors (one per player), restarted together until this subshell is told to stop.
 run_pair() {
-  local i=$1 port=$((base_port + 10 * $1)) restart=0 server="" actor="" stopping=0
-  trap 'stopping=1; [[ -z $actor ]] || kill -TERM "$actor" 2>/dev/null; [[ -z $server ]] || kill -TERM -- "-$server" 2>/dev/null' TERM INT
+  local i=$1 port=$((base_port + 10 * $1)) restart=0 server="" stopping=0 k name alog
+  local -a team=()
+  trap 'stopping=1; for a in "${team[@]}"; do kill -TERM "$a" 2>/dev/null; done; [[ -z $server ]] || kill -TERM -- "-$server" 2>/dev/null' TERM INT
   while ((stopping == 0)); do
     local log=$log_dir/hfo-$port.log
-    (cd "$log_dir" && exec setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 "${defense[@]}" --headless \
+    (cd "$log_dir" && exec setsid "$py" "$hfo_root/bin/HFO" --offense-agents "$agents" "${defense[@]}" --headless \
       --fullstate --no-logging --frames-per-trial 500 --port "$port" --seed $((seed + 100 * i + restart)) >"$log" 2>&1) &
     server=$!
-    until grep -q "Waiting for player-controlled agent" "$log" 2>/dev/null; do
-      kill -0 "$server" 2>/dev/null || { echo "hfo-server-actors: server on port $port exited; see $log" >&2; break; }
-      sleep 0.2
-    done
-    if kill -0 "$server" 2>/dev/null && ((stopping == 0)); then
+    team=()
+    for ((k = 0; k < agents; k++)); do
+      # HFO's trainer says it waits for an agent once per player slot; the k-th actor joins
+      # after the k-th time (an agent that joins earlier breaks the server, docs/hfo-server.md).
+      until (($(grep -c "Waiting for player-controlled agent" "$log" 2>/dev/null || true) > k)); do
+        kill -0 "$server" 2>/dev/null || { echo "hfo-server-actors: server on port $port exited; see $log" >&2; break 2; }
+        ((stopping == 0)) || break 2
+        sleep 0.2
+      done
+      name=hfo-actor-$i
+      alog=$log_dir/actor-$i.log
+      if ((agents > 1)); then
+        name=hfo-actor-$i-$k
+        alog=$log_dir/actor-$i-$k.log
+      fi
       # No --seed: the actor seeds its exploration from the run's seed and its index, as in
       # deploy/local-cluster.sh; the server's --seed above decides the episodes' starts.
-      "$bin" actor --join "$join" --server-port "$port" --name "hfo-actor-$i" \
-        "${security[@]}" >>"$log_dir/actor-$i.log" 2>&1 &
-      actor=$!
-      wait "$actor" || true
-      wait "$actor" 2>/dev/null || true  # a trap interrupts the first wait
-      actor=""
+      "$bin" actor --join "$join" --server-port "$port" --name "$name" "${security[@]}" >>"$alog" 2>&1 &
+      team+=($!)
+    done
+    if ((${#team[@]} > 0)); then
+      wait -n "${team[@]}" || true  # the first actor of the team to stop ends the game
     fi
+    for a in "${team[@]}"; do kill -TERM "$a" 2>/dev/null || true; done
+    for a in "${team[@]}"; do wait "$a" 2>/dev/null || true; done
+    team=()
     kill -TERM -- "-$server" 2>/dev/null || true
     wait "$server" 2>/dev/null || true
     server=""
@@ -120,7 +141,11 @@ trap stop_all INT TERM EXIT
 for ((i = 0; i < actors; i++)); do
   run_pair "$i" &
   pairs+=($!)
-  echo "actor $i: HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i.log"
+  if ((agents == 1)); then
+    echo "actor $i: HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i.log"
+  else
+    echo "team $i: $agents actors on the HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i-*.log"
+  fi
 done
-echo "hfo-server-actors: $actors actors joining $join; Ctrl-C stops them and their servers"
+echo "hfo-server-actors: $actors servers with $agents actors each joining $join; Ctrl-C stops them and their servers"
 wait

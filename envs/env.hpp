@@ -10,6 +10,10 @@
 //  - Status 0 means "episode goes on"; any other value is a terminal outcome named by
 //    status_name(). An env lists every outcome it can produce in outcomes().
 //  - Not thread-safe: one env per thread. step() and reset() must not allocate.
+//  - A team game (agents() = n > 1: HFO's --offense-agents n) steps n learned players at once,
+//    each on its own observation: every observation span holds n of them, player-major (player
+//    i's at [i * observation_size(), (i + 1) * observation_size())), and step_team() is the
+//    step. observation_size() and action_space() are one player's.
 #pragma once
 
 #include <cstdint>
@@ -59,6 +63,17 @@ class Env {
   virtual void reset(uint64_t seed, std::span<float> obs) = 0;
   virtual void reset(std::span<float> obs) = 0;
   virtual StepResult step(const ParamAction& action, std::span<float> obs) = 0;
+
+  // Learned players it steps at once; 1 but for a team game.
+  [[nodiscard]] virtual int agents() const { return 1; }
+  // One step of every player: actions[i] is player i's; writes each player's next observation
+  // and its reward (rewards[i]). The result's status is the game's, its reward the players'
+  // mean. The default, for one player, is step().
+  virtual StepResult step_team(std::span<const ParamAction> actions, std::span<float> obs, std::span<float> rewards) {
+    const StepResult r = step(actions[0], obs);
+    rewards[0] = r.reward;
+    return r;
+  }
 };
 
 }  // namespace pamdp

@@ -22,8 +22,26 @@ uint64_t confirmation_seed(uint64_t run_seed, int64_t updates) {
 
 EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const std::function<void(int)>& on_episode,
                     const std::function<void(const EvalStep&)>& on_step) {
-  std::vector<float> obs(static_cast<size_t>(env.observation_size()));
-  std::vector<float> seen(on_step ? obs.size() : 0);  // the observation the policy acted on
+  Policy* one = &policy;
+  return evaluate(env, std::span<Policy* const>(&one, 1), episodes, seed, on_episode, on_step);
+}
+
+EvalResult evaluate(Env& env, std::span<Policy* const> players, int episodes, uint64_t seed,
+                    const std::function<void(int)>& on_episode, const std::function<void(const EvalStep&)>& on_step) {
+  const auto n = static_cast<size_t>(env.agents());
+  if (players.size() != 1 && players.size() != n) {
+    throw std::invalid_argument("evaluate: " + std::to_string(players.size()) + " policies for a game of " +
+                                std::to_string(n) + " players; give one, or one per player");
+  }
+  const auto obs_dim = static_cast<size_t>(env.observation_size());
+  const auto width = static_cast<size_t>(env.action_space().output_width());
+  std::vector<float> obs(n * obs_dim);
+  std::vector<float> seen(on_step ? obs.size() : 0);  // the observations the policies acted on
+  // A policy's action views its own buffer until its next act(): each player's parameters are
+  // copied out before the next player acts.
+  std::vector<float> params(n * width);
+  std::vector<ParamAction> actions(n);
+  std::vector<float> rewards(n);
   std::vector<int> counts(8, 0);
   EvalResult res;
   res.episodes = episodes;
@@ -35,25 +53,45 @@ EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed, const
   for (const EnvCounter& c : env.counters()) {
     counters_before.push_back(c.value);
   }
+  const auto policy_of = [&](size_t i) -> Policy& { return *players[players.size() == 1 ? 0 : i]; };
   for (int ep = 0; ep < episodes; ++ep) {
     if (ep == 0) {
       env.reset(seed, obs);
     } else {
       env.reset(obs);
     }
-    policy.begin_episode();
+    for (Policy* p : players) {
+      p->begin_episode();
+    }
     int steps = 0;
     StepResult sr;
     do {
-      const ParamAction action = policy.act(obs);
+      for (size_t i = 0; i < n; ++i) {
+        const ParamAction a = policy_of(i).act(std::span<const float>(obs).subspan(i * obs_dim, obs_dim));
+        const std::span<float> mine = std::span<float>(params).subspan(i * width, a.params.size());
+        std::copy(a.params.begin(), a.params.end(), mine.begin());
+        actions[i] = {a.id, mine};
+      }
       if (on_step) {
         std::copy(obs.begin(), obs.end(), seen.begin());
       }
-      sr = env.step(action, obs);
+      if (n == 1) {
+        sr = env.step(actions[0], obs);
+        rewards[0] = sr.reward;
+      } else {
+        sr = env.step_team(actions, obs, rewards);
+      }
       total_return += sr.reward;
       ++steps;
       if (on_step) {
-        on_step(EvalStep{ep, steps, seen, action, sr});
+        for (size_t i = 0; i < n; ++i) {
+          on_step(EvalStep{ep,
+                           steps,
+                           std::span<const float>(seen).subspan(i * obs_dim, obs_dim),
+                           actions[i],
+                           {rewards[i], sr.status},
+                           static_cast<int>(i)});
+        }
       }
     } while (!sr.terminal() && steps <= env.max_episode_steps());
     if (!sr.terminal()) {

@@ -33,13 +33,19 @@ struct EvalStep {
   int step = 0;     // 1-based within the episode
   std::span<const float> obs;
   ParamAction action;
-  StepResult result;
+  StepResult result;  // a team's: the game's status and this player's reward
+  int player = 0;     // in a team game (Env::agents() > 1), whose step this is; each player's in turn
 };
 
-// Plays `episodes` episodes; the first reset uses `seed`, later ones continue the env's stream.
-// `on_episode`, when given, is called with the number of episodes done after each one;
+// Plays `episodes` episodes (every player of a team game with `policy`); the first reset uses `seed`, later ones
+// continue the env's stream. `on_episode`, when given, is called with the number of episodes done after each one;
 // `on_step`, when given, after every step (the results do not depend on either).
 EvalResult evaluate(Env& env, Policy& policy, int episodes, uint64_t seed,
+                    const std::function<void(int)>& on_episode = {},
+                    const std::function<void(const EvalStep&)>& on_step = {});
+// A team game (Env::agents() > 1): `players` holds one policy for every player (parameter
+// sharing: each acts on its own observation), or one per player. The return is the players' mean.
+EvalResult evaluate(Env& env, std::span<Policy* const> players, int episodes, uint64_t seed,
                     const std::function<void(int)>& on_episode = {},
                     const std::function<void(const EvalStep&)>& on_step = {});
 

@@ -390,7 +390,8 @@ class PyTeamEnv {
     hfo::SoccerSimConfig c = hfo::sim_config(config_.params);
     c.offense_agents = agents;
     env_ = std::make_unique<hfo::HfoTeamEnv>(c, config_.params.boolean("shoot_action"),
-                                             static_cast<int>(config_.params.integer("out_of_bounds_penalty")));
+                                             static_cast<int>(config_.params.integer("out_of_bounds_penalty")),
+                                             config_.params.boolean("team_reward"));
     width_ = static_cast<size_t>(env_->observation_size());
     obs_.resize(width_ * static_cast<size_t>(agents));
     rewards_.resize(static_cast<size_t>(agents));

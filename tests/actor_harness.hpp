@@ -227,9 +227,11 @@ inline ActorLoopConfig test_loop_config() {
 // thread on destruction. Declare it after the fakes and the Context it uses.
 class ActorRunner {
  public:
+  // make_env: the envs it steps (ReachStop by default).
   ActorRunner(net::Context& ctx, const std::string& join_endpoint, ActorLoopConfig config, int envs = 2,
-              int join_retry_ms = 2000, std::function<void(const ActorCounters&, double)> on_tick = nullptr) {
-    thread_ = std::thread([this, &ctx, join_endpoint, config, envs, join_retry_ms, on_tick] {
+              int join_retry_ms = 2000, std::function<void(const ActorCounters&, double)> on_tick = nullptr,
+              std::function<std::unique_ptr<Env>()> make_env = nullptr) {
+    thread_ = std::thread([this, &ctx, join_endpoint, config, envs, join_retry_ms, on_tick, make_env] {
       LearnerLinkConfig lc;
       lc.join_endpoint = join_endpoint;
       lc.name = "test-actor";
@@ -243,7 +245,7 @@ class ActorRunner {
       config_toml = map->config_toml;
       std::vector<std::unique_ptr<Env>> list;
       for (int k = 0; k < envs; ++k) {
-        list.push_back(std::make_unique<toy::ReachStopEnv>());
+        list.push_back(make_env ? make_env() : std::make_unique<toy::ReachStopEnv>());
       }
       ActorLoop loop(ctx, std::move(link), *map, std::move(list), config, counters);
       loop.on_tick = on_tick;

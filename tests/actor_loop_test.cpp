@@ -176,6 +176,101 @@ TEST(ActorLoop, JoinsAndShipsTransitionsWithMonteCarloReturnsAndEpisodeReports) 
   EXPECT_LE(learner.last_heartbeat_counters[3], learner.last_heartbeat_counters[0]);
 }
 
+// Two ReachStop players in one game (Env::agents() = 2), each on its own observation, rewarded
+// on its own; the game ends when player 0's episode ends (player 1's last row is terminal too).
+class ReachStopPair final : public Env {
+ public:
+  [[nodiscard]] std::string_view name() const override { return "reach_stop_pair"; }
+  [[nodiscard]] const ActionSpace& action_space() const override { return a_.action_space(); }
+  [[nodiscard]] int observation_size() const override { return toy::ReachStopEnv::kObservationSize; }
+  [[nodiscard]] int max_episode_steps() const override { return a_.max_episode_steps(); }
+  [[nodiscard]] std::string_view status_name(int status) const override { return a_.status_name(status); }
+  [[nodiscard]] std::span<const int> outcomes() const override { return a_.outcomes(); }
+  [[nodiscard]] int success_status() const override { return a_.success_status(); }
+  [[nodiscard]] int agents() const override { return 2; }
+  void reset(uint64_t seed, std::span<float> obs) override {
+    a_.reset(seed, obs.first(kObs));
+    b_.reset(seed + 1, obs.subspan(kObs, kObs));
+    b_over_ = false;
+  }
+  void reset(std::span<float> obs) override {
+    a_.reset(obs.first(kObs));
+    b_.reset(obs.subspan(kObs, kObs));
+    b_over_ = false;
+  }
+  StepResult step(const ParamAction& /*action*/, std::span<float> /*obs*/) override {
+    ADD_FAILURE() << "a team's step is step_team()";
+    return {0.0F, toy::ReachStopEnv::kOutOfTime};
+  }
+  StepResult step_team(std::span<const ParamAction> actions, std::span<float> obs, std::span<float> rewards) override {
+    const StepResult ra = a_.step(actions[0], obs.first(kObs));
+    StepResult rb{0.0F, 0};
+    if (!b_over_) {  // player 1 stands still once its own episode is over
+      rb = b_.step(actions[1], obs.subspan(kObs, kObs));
+      b_over_ = rb.terminal();
+    }
+    rewards[0] = ra.reward;
+    rewards[1] = rb.reward;
+    return {(ra.reward + rb.reward) / 2.0F, ra.status};
+  }
+
+ private:
+  toy::ReachStopEnv a_, b_;
+  bool b_over_ = false;
+};
+
+TEST(ActorLoop, ATeamShipsEachPlayersEpisodeAndReportsTheGameOnce) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  FakeShard shard(ctx);
+  learner.shard_endpoints = {shard.endpoint()};
+  const ActorLoopConfig config = test_loop_config();
+  ActorRunner actor(ctx, learner.join_endpoint(), config, /*envs=*/1, 2000, nullptr,
+                    [] { return std::make_unique<ReachStopPair>(); });
+  ASSERT_TRUE(
+      serve_until(learner, {&shard}, [&] { return shard.batches.size() >= 20 && learner.reports.size() >= 20; }));
+  EXPECT_EQ(shard.invalid, 0);
+  // Each game is two episodes of equal length in a row (player 0's, then player 1's), each ending
+  // in a terminal row, with its own returns.
+  const BatchCopy rows = concat(shard.batches);
+  const std::vector<std::pair<size_t, size_t>> episodes = episodes_in(rows);
+  ASSERT_GE(episodes.size(), 20U);
+  const auto gamma = static_cast<float>(config.gamma);
+  for (size_t k = 0; k + 1 < episodes.size(); k += 2) {
+    const auto [b0, e0] = episodes[k];
+    const auto [b1, e1] = episodes[k + 1];
+    ASSERT_EQ(e0 - b0, e1 - b1) << "game " << k / 2 << ": both players keep a row per cycle";
+    for (size_t t = b1; t + 1 < e1; ++t) {
+      EXPECT_NEAR(rows.returns[t], rows.rewards[t] + gamma * rows.returns[t + 1], 1e-5);
+    }
+  }
+  // One report per game, with the game's steps and the players' mean return.
+  size_t checked = 0;
+  for (const ReportCopy& r : learner.reports) {
+    if (2 * r.episode > episodes.size()) {
+      break;
+    }
+    const auto [b0, e0] = episodes[2 * (r.episode - 1)];
+    const auto [b1, e1] = episodes[2 * (r.episode - 1) + 1];
+    EXPECT_EQ(r.steps, e0 - b0);
+    float sum = 0.0F;
+    for (size_t t = b0; t < e0; ++t) {
+      sum += rows.rewards[t];
+    }
+    for (size_t t = b1; t < e1; ++t) {
+      sum += rows.rewards[t];
+    }
+    EXPECT_NEAR(r.ret, sum / 2.0F, 1e-4);
+    ++checked;
+  }
+  EXPECT_GE(checked, 5U);
+  // A cycle is a decision of each player: env_steps counts both.
+  ASSERT_TRUE(serve_until(learner, {&shard}, [&] {
+    return learner.last_heartbeat_counters.size() == 7 && learner.last_heartbeat_counters[0] > 0;
+  }));
+  EXPECT_EQ(actor.counters.env_steps.load() % 2, 0);
+}
+
 // A teacher that always moves at velocity 0.25: its ReachStop episodes run to the time limit.
 class SlowMover final : public Policy {
  public:

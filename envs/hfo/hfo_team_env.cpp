@@ -1,5 +1,7 @@
 #include "envs/hfo/hfo_team_env.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 
@@ -11,11 +13,24 @@ namespace {
   std::abort();
 }
 
+float mean_of(std::span<const float> v) {
+  float sum = 0.0F;
+  for (float x : v) {
+    sum += x;
+  }
+  return sum / static_cast<float>(v.size());
+}
+
 }  // namespace
 
-HfoTeamEnv::HfoTeamEnv(const SoccerSimConfig& config, bool shoot_action, int out_of_bounds_penalty)
-    : sim_(config), shoot_(shoot_action) {
+HfoTeamEnv::HfoTeamEnv(const SoccerSimConfig& config, bool shoot_action, int out_of_bounds_penalty, bool team_reward)
+    : sim_(config), shoot_(shoot_action), team_reward_(team_reward) {
   rewards_.fill(ShapedReward(out_of_bounds_penalty));
+}
+
+std::span<const int> HfoTeamEnv::outcomes() const {
+  static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
+  return kOutcomes;
 }
 
 void HfoTeamEnv::write_all(std::span<float> obs) const {
@@ -76,7 +91,24 @@ int HfoTeamEnv::step(std::span<const ParamAction> actions, std::span<float> obs,
     rewards[static_cast<size_t>(i)] =
         rewards_[static_cast<size_t>(i)](obs.subspan(static_cast<size_t>(i) * n, n), status);
   }
+  if (team_reward_) {
+    const float mean = mean_of(rewards);
+    std::fill(rewards.begin(), rewards.end(), mean);
+  }
   return status;
+}
+
+StepResult HfoTeamEnv::step_team(std::span<const ParamAction> actions, std::span<float> obs, std::span<float> rewards) {
+  const int status = step(actions, obs, rewards);
+  return {mean_of(rewards), status};
+}
+
+StepResult HfoTeamEnv::step(const ParamAction& action, std::span<float> obs) {
+  if (agents() != 1) {
+    misuse("step() with one action on a team of several; use step_team()");
+  }
+  float reward = 0.0F;
+  return step_team({&action, 1}, obs, {&reward, 1});
 }
 
 }  // namespace pamdp::hfo

@@ -3,6 +3,7 @@
 
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
 #include "envs/hfo/settings.hpp"
 #include "envs/registry.hpp"
 
@@ -70,6 +71,10 @@ bool shoot_action(const EnvParams& params) {
   return params.contains("shoot_action") && params.boolean("shoot_action");
 }
 
+EnvKey offense_agents_key() {
+  return EnvKey::integer("offense_agents", SoccerSimConfig{}.offense_agents, 1, kMaxOffenseAgents);
+}
+
 EnvKey max_steps_key() {
   return EnvKey::integer("max_steps", SoccerSimConfig{}.max_steps, 1, 1000000);
 }
@@ -83,7 +88,8 @@ std::vector<EnvKey> sim_keys() {
       EnvKey::choice("body_at_reset", name_of(body_at_reset_names(), d.body_at_reset), names_of(body_at_reset_names())),
       max_steps_key(),
       EnvKey::integer("untouched_limit", d.untouched_limit, 1, 1000000),
-      goalie_key()};
+      goalie_key(),
+      offense_agents_key()};
 }
 
 SoccerSimConfig sim_config(const EnvParams& params) {
@@ -95,6 +101,7 @@ SoccerSimConfig sim_config(const EnvParams& params) {
   c.max_steps = static_cast<int>(params.integer("max_steps"));
   c.untouched_limit = static_cast<int>(params.integer("untouched_limit"));
   c.goalie = params.boolean("goalie");
+  c.offense_agents = static_cast<int>(params.integer("offense_agents"));
   return c;
 }
 
@@ -106,6 +113,7 @@ void set_sim_config(EnvParams& params, const SoccerSimConfig& config) {
   params.set("max_steps", int64_t{config.max_steps});
   params.set("untouched_limit", int64_t{config.untouched_limit});
   params.set("goalie", config.goalie);
+  params.set("offense_agents", int64_t{config.offense_agents});
 }
 
 }  // namespace hfo
@@ -113,17 +121,25 @@ void set_sim_config(EnvParams& params, const SoccerSimConfig& config) {
 void register_hfo_env(EnvRegistry& registry) {
   EnvRegistration r;
   r.name = "hfo";
-  r.description = "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true)";
+  r.description =
+      "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true; 8 more per teammate with "
+      "env.offense_agents = N, a team of N learned players)";
   r.keys = hfo::sim_keys();
   r.keys.push_back(hfo::shoot_action_key());
   // Subtracted from the reward when the ball goes out of bounds (hfo::ShapedReward); 0 keeps
   // dqn-hfo's reward. In the reward's units: a goal is 5.
   r.keys.push_back(EnvKey::integer("out_of_bounds_penalty", 0, 0, 100));
-  r.make = [](const EnvParams& p) {
-    return std::make_unique<hfo::HfoEnv>(hfo::sim_config(p), p.boolean("shoot_action"),
-                                         static_cast<int>(p.integer("out_of_bounds_penalty")));
+  // With env.offense_agents > 1: every player earns the team's mean shaped reward, not its own.
+  r.keys.push_back(EnvKey::boolean("team_reward", false));
+  r.make = [](const EnvParams& p) -> std::unique_ptr<Env> {
+    const hfo::SoccerSimConfig c = hfo::sim_config(p);
+    const int penalty = static_cast<int>(p.integer("out_of_bounds_penalty"));
+    if (c.offense_agents > 1) {
+      return std::make_unique<hfo::HfoTeamEnv>(c, p.boolean("shoot_action"), penalty, p.boolean("team_reward"));
+    }
+    return std::make_unique<hfo::HfoEnv>(c, p.boolean("shoot_action"), penalty);
   };
-  r.observation_size = [](const EnvParams& p) { return hfo::HfoEnv(hfo::sim_config(p)).observation_size(); };
+  r.observation_size = [](const EnvParams& p) { return hfo::HfoTeamEnv(hfo::sim_config(p)).observation_size(); };
   r.gives_embedded_hfo_features = [](const EnvParams&) { return true; };
   r.hfo_actions = true;
   r.action_gates = {{"KICK", hfo::feat::kKickable}};  // the client sends no kick without it

@@ -21,6 +21,9 @@ const Names<BodyAtReset>& body_at_reset_names();  // carry, zero, uniform
 // The keys, with SoccerSimConfig's defaults.
 EnvKey goalie_key();
 EnvKey max_steps_key();
+// env.offense_agents: HFO's --offense-agents N (1-4). The embedded game plays all N as one team
+// env (Env::agents() = N); on the real server each env is one of the N.
+EnvKey offense_agents_key();
 // env.shoot_action: the action space with SHOOT, a second kick (hfo_env.hpp); read by hfo and
 // hfo-server alike, so a policy trained with it plays on the real server.
 EnvKey shoot_action_key();

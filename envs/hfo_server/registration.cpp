@@ -51,7 +51,7 @@ void register_hfo_server_env(EnvRegistry& registry) {
             EnvKey::text("server_team", d.team), EnvKey::text_or_empty("server_config_dir", d.config_dir),
             EnvKey::integer("server_connect_timeout_s", d.connect_timeout_s, 1, 3600), hfo::shoot_action_key(),
             // bin/HFO --offense-agents N: this env plays one of the N, the others are other processes.
-            EnvKey::integer("offense_agents", d.teammates + 1, 1, hfo::kMaxOffenseAgents)};
+            hfo::offense_agents_key()};
   r.make = [](const EnvParams& p) { return hfo_server::make_hfo_server_env(hfo_server::server_config(p)); };
   r.observation_size = [](const EnvParams& p) { return hfo_server::observation_size(hfo_server::server_config(p)); };
   r.gives_embedded_hfo_features = [](const EnvParams& p) { return p.text("server_encoding") == "embedded"; };
