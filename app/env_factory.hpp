@@ -41,14 +41,15 @@ inline std::unique_ptr<Env> make_eval_env(const ExperimentConfig& c) {
 
 // The teacher of demonstrations and labels (exploration.demo_fraction, demo_relabel) for one
 // player: the scripted offense (exploration.demo_shot), or in a team (env.offense_agents > 1) the
-// scripted team player. A team game takes one per player.
+// scripted team player (passing as exploration.demo_pass_within says). A team game takes one per
+// player.
 inline std::unique_ptr<Policy> make_teacher(const ExperimentConfig& c) {
   const bool shoot = hfo::shoot_action(c.env.params);
   const int agents =
       c.env.params.contains("offense_agents") ? static_cast<int>(c.env.params.integer("offense_agents")) : 1;
   if (agents > 1) {
     const int opponents = c.env.params.contains("goalie") && c.env.params.boolean("goalie") ? 1 : 0;
-    return std::make_unique<hfo::ScriptedTeamPlayer>(agents - 1, opponents, shoot);
+    return std::make_unique<hfo::ScriptedTeamPlayer>(agents - 1, opponents, shoot, c.demo_pass_within);
   }
   return std::make_unique<hfo::ScriptedOffense>(c.demo_shot, shoot);
 }

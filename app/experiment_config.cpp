@@ -108,6 +108,7 @@ void visit(V& v, ExperimentConfig& c) {
   v.real("exploration.demo_fraction_end", c.exploration.demo_fraction_end, 0.0, 1.0);
   v.boolean("exploration.demo_relabel", c.exploration.demo_relabel);
   v.choice("exploration.demo_shot", c.demo_shot, shot_aim_choices());
+  v.real("exploration.demo_pass_within", c.demo_pass_within, 0.0, 100.0);
 
   v.integer("replay.capacity", c.replay.capacity, 1, int64_t{1} << 32);
   v.integer("replay.warmup", c.replay.warmup, 1, int64_t{1} << 32);
@@ -512,6 +513,12 @@ void validate(const ExperimentConfig& c, const std::string& src) {
                              ": exploration.demo_relabel = true labels the agent's steps for cloning, and nothing "
                              "clones: set ddpg.demo_bc_weight > 0 (with exploration.demo_fraction > 0), or "
                              "exploration.demo_relabel = false");
+  }
+  const bool team = c.env.params.contains("offense_agents") && c.env.params.integer("offense_agents") > 1;
+  if (c.demo_pass_within != hfo::ScriptedTeamPlayer::kPassWhenOpponentWithin && !team) {
+    throw std::runtime_error(src +
+                             ": exploration.demo_pass_within sets when the scripted team player passes, and there "
+                             "is no team: set env.offense_agents > 1, or leave exploration.demo_pass_within out");
   }
   if (c.demo_shot != hfo::ShotAim::kBestCourse && c.exploration.demo_fraction <= 0.0) {
     throw std::runtime_error(src +

@@ -13,6 +13,7 @@
 
 #include "actor/exploration.hpp"
 #include "envs/hfo/scripted_offense.hpp"
+#include "envs/hfo/scripted_team.hpp"
 #include "envs/hfo/soccer_sim.hpp"
 #include "envs/registry.hpp"
 #include "learner/algorithm.hpp"
@@ -94,6 +95,9 @@ struct ExperimentConfig {
   // The scripted offense's shot when it demonstrates and labels (exploration.demo_shot), and
   // in `pamdp eval --agreement` on a checkpoint trained with it.
   hfo::ShotAim demo_shot = hfo::ShotAim::kBestCourse;
+  // In a team (env.offense_agents > 1) the scripted team player teaches; it passes when an
+  // opponent comes this close to the ball (metres; exploration.demo_pass_within; 0 never passes).
+  double demo_pass_within = hfo::ScriptedTeamPlayer::kPassWhenOpponentWithin;
   ReplayConfig replay;
   TrainLoopConfig train;
   ClusterConfig cluster;

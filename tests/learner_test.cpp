@@ -992,6 +992,44 @@ TEST(Train, ResumeIsBitForBit) {
   fs::remove_all(b);
 }
 
+// A team game (HFO 2v0, env.offense_agents = 2, with demonstrations by the scripted team) stopped
+// between episodes and resumed ends where a run that never stopped does: both players' transitions
+// in replay, the teachers' draws and the weights alike. The bodies start each episode at 0
+// (env.body_at_reset = "zero"): with the presets' "carry" an episode starts from the bodies the
+// last one left, which a checkpoint does not keep, so a resumed HFO run, one player or several,
+// takes another path from its first episode on.
+TEST(Train, ATeamResumesBitForBit) {
+  const fs::path a = fresh_dir("team_straight");
+  const fs::path b = fresh_dir("team_halves");
+  std::ifstream in(std::string(PAMDP_SOURCE_DIR) + "/deploy/configs/hfo-2v0-mpdqn.toml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  app::ExperimentConfig full =
+      app::parse_experiment_config(ss.str(), "hfo-2v0-mpdqn.toml",
+                                   {"ddpg.hidden=[16, 16]", "replay.warmup=200", "replay.capacity=20000",
+                                    "train.max_updates=1500", "train.eval_every_updates=1000", "train.eval_episodes=5",
+                                    "train.confirm_episodes=0", "exploration.demo_fraction=0.3", "env.max_steps=120",
+                                    "train.log_every_seconds=1e9", "env.body_at_reset=\"zero\""});
+  const app::TrainSummary straight = app::train(full, {a.string(), false, true, nullptr});
+  EXPECT_EQ(straight.updates, 1500);
+  EXPECT_EQ(straight.env_steps % 2, 0) << "a cycle of the game is a decision of each player";
+  app::ExperimentConfig half = full;
+  half.train.max_episodes = episodes_before(a, 700);
+  ASSERT_GT(half.train.max_episodes, 0);
+  const app::TrainSummary first = app::train(half, {b.string(), false, true, nullptr});
+  ASSERT_LT(first.updates, 1000);
+  const app::TrainSummary second = app::train(full, {b.string(), true, true, nullptr});
+  EXPECT_EQ(second.updates, 1500);
+  EXPECT_EQ(second.env_steps, straight.env_steps);
+  // The replay memory holds every action the acting network chose, so it matches only if the
+  // weights did all along; the final evaluation plays the last weights.
+  EXPECT_EQ(read_file_bytes((a / "replay.bin").string()), read_file_bytes((b / "replay.bin").string()));
+  EXPECT_EQ(second.final_eval.avg_return, straight.final_eval.avg_return);
+  EXPECT_EQ(second.final_eval.avg_steps, straight.final_eval.avg_steps);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
 TEST(Checkpoint, CorruptOrMismatchedIsRefused) {
   const fs::path dir = fresh_dir("corrupt");
   fs::create_directories(dir);
