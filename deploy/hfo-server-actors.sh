@@ -132,7 +132,7 @@ run_pair() {
 pairs=()
 stop_all() {
   trap - INT TERM EXIT
-  echo "hfo-server-actors: stopping ${#pairs[@]} actors and their servers..." >&2
+  echo "hfo-server-actors: stopping ${#pairs[@]} servers and their actors..." >&2
   for p in "${pairs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
 }
