@@ -437,6 +437,31 @@ TEST(Cli, EvalPlaysAScriptedTeam) {
   EXPECT_NE(bad.output.find("leave out --offense-agents"), std::string::npos) << bad.output;
 }
 
+// The committed 2v0 team plays as trained: both players from one network, the team's row.
+TEST(Cli, EvalPlaysATeamCheckpoint) {
+  const std::string model = std::string(PAMDP_SOURCE_DIR) + "/models/hfo-2v0-mpdqn-seed1.ckpt";
+  const std::string trace = (std::filesystem::temp_directory_path() / "pamdp_cli_team_trace.csv").string();
+  const RunResult r =
+      run_pamdp("eval --checkpoint " + quoted(model) + " --episodes 100 --seed 77 --json --trace " + quoted(trace),
+                Capture::kStdoutOnly);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string json = last_line(r.output);
+  const auto at = json.find("\"goal_rate\":");
+  ASSERT_NE(at, std::string::npos) << json;
+  EXPECT_GT(std::stod(json.substr(at + 12)), 0.95) << json;  // .987 on 1,000 of these episodes
+  std::ifstream in(trace);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("episode,step,player,action,", 0), 0U) << header;
+  std::string row0;
+  std::string row1;
+  std::getline(in, row0);
+  std::getline(in, row1);
+  EXPECT_EQ(row0.rfind("0,1,0,", 0), 0U) << row0;
+  EXPECT_EQ(row1.rfind("0,1,1,", 0), 0U) << row1;
+  std::filesystem::remove(trace);
+}
+
 // Two offense players (issue 79): STATE.json's teammates, one action each per row separated by
 // '|', player 0's features (58 + 8 for the teammate) and every player's and the ball's state at
 // the end of each row. Both kick the touching ball in one cycle: player 0 (body 0) KICK 100 at
