@@ -5,12 +5,17 @@
 // episode ends, batch sends, episode reports, heartbeats and their answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <new>
 
+#include "actor/episode_player.hpp"
 #include "actor_harness.hpp"
 #include "counting_new.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
+#include "envs/hfo/scripted_team.hpp"
 
 namespace pamdp::testing {
 namespace {
@@ -67,6 +72,44 @@ TEST(ActorLoopAllocations, SteadyStateActingAllocatesNothing) {
   EXPECT_GT(batches_counted.load(), 10);
   EXPECT_GT(episodes_counted.load(), 10);
   EXPECT_EQ(alloc::allocations(), 0) << "over " << steps_counted.load() << " env steps";
+}
+
+// A team game (2v1, issue 79) through the episode player, as `pamdp train` and the actors play
+// it: the network's output for each player, ε-greedy draws, demonstrations and labels by one
+// scripted team player per player, each player's episode kept. Nothing allocates once built.
+TEST(EpisodePlayerAllocations, ATeamGameAllocatesNothing) {
+  hfo::SoccerSimConfig config;
+  config.goalie = true;
+  config.offense_agents = 2;
+  hfo::HfoTeamEnv env(config);
+  hfo::ScriptedTeamPlayer t0(1, 1);
+  hfo::ScriptedTeamPlayer t1(1, 1);
+  std::array<Policy*, 2> teachers{&t0, &t1};
+  EpisodePlayer player(env, teachers, /*labels=*/true);
+  ExplorationConfig x;
+  EpsilonGreedy explore(env.action_space(), x, 5);
+  Rng rng(7);
+  const EpisodePlayer::Act act = [](std::span<const float> obs, std::span<float> out) {
+    std::fill(out.begin(), out.end(), 0.0F);
+    out[hfo::kDash] = obs[0];  // some output that depends on the observation
+    out[hfo::kKick] = 0.5F;
+  };
+  player.begin(1, 0.5, rng);  // a first episode outside the count
+  long allocations = 0;
+  int steps = 0;
+  {
+    alloc::CountAllocations scope;
+    for (int ep = 0; ep < 30; ++ep) {
+      player.begin(static_cast<uint64_t>(ep), 0.5, rng);
+      while (!player.ended()) {
+        player.step(act, explore, 0.2);
+        ++steps;
+      }
+    }
+    allocations = scope.count();
+  }
+  EXPECT_GT(steps, 1000);
+  EXPECT_EQ(allocations, 0) << "over " << steps << " cycles of a 2v1 game";
 }
 
 }  // namespace
