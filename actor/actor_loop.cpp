@@ -97,28 +97,15 @@ std::vector<std::unique_ptr<Policy>> make_teachers(const Env& env,
   return out;
 }
 
-std::vector<Policy*> pointers(const std::vector<std::unique_ptr<Policy>>& v) {
-  std::vector<Policy*> out;
-  for (const auto& p : v) {
-    out.push_back(p.get());
-  }
-  return out;
-}
-
 struct EnvSlot {
   std::unique_ptr<Env> env;
   std::vector<std::unique_ptr<Policy>> teachers;  // with demonstrations, one per player
-  std::vector<Policy*> teacher_ptrs;
-  EpisodePlayer player;  // its episodes, played as `pamdp train` plays them
+  EpisodePlayer player;                           // its episodes, played as `pamdp train` plays them
   uint64_t seed = 0;
   uint64_t episodes = 0;
 
   EnvSlot(std::unique_ptr<Env> e, const std::function<std::unique_ptr<Policy>()>& make_teacher, bool labels, uint64_t s)
-      : env(std::move(e)),
-        teachers(make_teachers(*env, make_teacher)),
-        teacher_ptrs(pointers(teachers)),
-        player(*env, teacher_ptrs, labels),
-        seed(s) {}
+      : env(std::move(e)), teachers(make_teachers(*env, make_teacher)), player(*env, teachers, labels), seed(s) {}
 };
 
 // The sequences of the batches sent to one shard and not yet acknowledged, oldest first: a ring

@@ -5,10 +5,25 @@
 #include <utility>
 
 namespace pamdp {
+namespace {
+
+std::vector<Policy*> raw_pointers(std::span<const std::unique_ptr<Policy>> owned) {
+  std::vector<Policy*> out;
+  out.reserve(owned.size());
+  for (const auto& p : owned) {
+    out.push_back(p.get());
+  }
+  return out;
+}
+
+}  // namespace
 
 EpisodePlayer::EpisodePlayer(Env& env, Policy* teacher, bool labels)
     : EpisodePlayer(env, teacher == nullptr ? std::span<Policy* const>{} : std::span<Policy* const>(&teacher, 1),
                     labels) {}
+
+EpisodePlayer::EpisodePlayer(Env& env, std::span<const std::unique_ptr<Policy>> teachers, bool labels)
+    : EpisodePlayer(env, std::span<Policy* const>(raw_pointers(teachers)), labels) {}
 
 EpisodePlayer::EpisodePlayer(Env& env, std::span<Policy* const> teachers, bool labels)
     : env_(env), teachers_(teachers.begin(), teachers.end()), space_(env.action_space()) {

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -41,6 +42,8 @@ class EpisodePlayer {
   // For a team: `teachers` is empty (none) or holds one per player (std::invalid_argument
   // otherwise).
   EpisodePlayer(Env& env, std::span<Policy* const> teachers, bool labels);
+  // The same, for teachers the caller owns as unique_ptrs.
+  EpisodePlayer(Env& env, std::span<const std::unique_ptr<Policy>> teachers, bool labels);
 
   // Resets the env with env_seed and starts an episode, played by the teacher with probability
   // demo_share. The draw comes from rng only when demo_share > 0, so runs without

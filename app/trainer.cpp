@@ -44,14 +44,6 @@ std::vector<std::unique_ptr<Policy>> make_teachers(const ExperimentConfig& c, co
   return out;
 }
 
-std::vector<Policy*> pointers(const std::vector<std::unique_ptr<Policy>>& v) {
-  std::vector<Policy*> out;
-  for (const auto& p : v) {
-    out.push_back(p.get());
-  }
-  return out;
-}
-
 class Trainer {
  public:
   Trainer(const ExperimentConfig& c, TrainOptions o)
@@ -67,9 +59,8 @@ class Trainer {
         replay_(c.replay.capacity, obs_dim_, width_),
         explore_(space_, exploration_, mix_seeds(c.seed, 2)),
         teachers_(make_teachers(c, *env_)),
-        teacher_ptrs_(pointers(teachers_)),
         sample_rng_(mix_seeds(c.seed, 3)),
-        player_(*env_, teacher_ptrs_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
+        player_(*env_, teachers_, algorithm_->clones_demonstrations() && c.exploration.demo_relabel),
         act_([this](std::span<const float> obs, std::span<float> out) { algorithm_->act(obs, out); }),
         run_(run_spec(c, o_.run_dir, exploration_, algorithm_->clones_demonstrations()), *algorithm_, *env_,
              *eval_env_) {
@@ -123,7 +114,6 @@ class Trainer {
   // The scripted offense (one per player of a team) plays exploration.demo_fraction of the
   // episodes and labels with demo_relabel.
   std::vector<std::unique_ptr<Policy>> teachers_;
-  std::vector<Policy*> teacher_ptrs_;
   Rng sample_rng_;
   std::optional<LocalSampler> sampler_;  // the updates' minibatches: replay_, and demo_replay_ to clone
   EpisodePlayer player_;                 // the episodes, played as the actors play them

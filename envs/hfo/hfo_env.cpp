@@ -85,8 +85,7 @@ HfoEnv::HfoEnv(const SoccerSimConfig& config, bool shoot_action, int out_of_boun
     : sim_(config), reward_(out_of_bounds_penalty), shoot_(shoot_action) {}
 
 std::span<const int> HfoEnv::outcomes() const {
-  static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
-  return kOutcomes;
+  return kStatuses;
 }
 
 void HfoEnv::begin_episode(std::span<float> obs) {

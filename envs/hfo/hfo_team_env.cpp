@@ -29,8 +29,7 @@ HfoTeamEnv::HfoTeamEnv(const SoccerSimConfig& config, bool shoot_action, int out
 }
 
 std::span<const int> HfoTeamEnv::outcomes() const {
-  static constexpr std::array<int, 5> kOutcomes{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
-  return kOutcomes;
+  return kStatuses;
 }
 
 void HfoTeamEnv::write_all(std::span<float> obs) const {

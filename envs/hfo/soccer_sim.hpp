@@ -34,6 +34,8 @@ enum Status : int {
   kOutOfTime = 4,
 };
 const char* status_name(int status);
+// Every status code, kInGame first (Env::outcomes() of the HFO envs).
+inline constexpr std::array<int, 5> kStatuses{kInGame, kGoal, kCapturedByDefense, kOutOfBounds, kOutOfTime};
 
 // Start-state distribution of the ball and the agent (reference §5.1).
 enum class StartDistribution {

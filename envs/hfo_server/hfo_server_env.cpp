@@ -88,11 +88,7 @@ class HfoServerEnv final : public Env {
   [[nodiscard]] int observation_size() const override { return hfo_server::observation_size(c_); }
   [[nodiscard]] int max_episode_steps() const override { return c_.max_steps + 1; }
   [[nodiscard]] std::string_view status_name(int status) const override { return hfo::status_name(status); }
-  [[nodiscard]] std::span<const int> outcomes() const override {
-    static constexpr std::array<int, 5> kOutcomes{hfo::kInGame, hfo::kGoal, hfo::kCapturedByDefense, hfo::kOutOfBounds,
-                                                  hfo::kOutOfTime};
-    return kOutcomes;
-  }
+  [[nodiscard]] std::span<const int> outcomes() const override { return hfo::kStatuses; }
   [[nodiscard]] int success_status() const override { return hfo::kGoal; }
   [[nodiscard]] std::span<const EnvCounter> counters() const override {
     counters_ = {{{"kick_power_clamped", clamps_.kick_power},
