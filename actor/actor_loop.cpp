@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -18,6 +19,16 @@
 
 namespace pamdp {
 namespace {
+
+// A nonzero random 64-bit id (0 means "no writer" on the wire).
+uint64_t draw_writer_id() {
+  std::random_device rd;
+  const uint64_t high = rd();
+  const uint64_t low = rd();
+  const uint64_t id =
+      (high << 32U) ^ low ^ static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+  return id == 0 ? 1 : id;
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -150,6 +161,7 @@ struct Shard {
   Clock::time_point last_progress;                 // the last acknowledgement, or the send into an empty window
   std::optional<Clock::time_point> blocked_since;  // first failed send of the current stall
   std::optional<Clock::time_point> skipped_until;  // out of the rotation until then, then probed
+  net::PeerCounters* peer = nullptr;               // its traffic (ActorCounters::peers)
 
   Shard(net::Context& ctx, std::string ep, int window)
       : endpoint(std::move(ep)), dealer(ctx, net::SocketType::kDealer), connection(ctx, dealer), unacked(window) {}
@@ -276,6 +288,9 @@ struct ActorLoop::Impl {
   std::optional<OutgoingBatch> demo_batch;  // for the demonstration table (config.demo_table)
   flatbuffers::FlatBufferBuilder batch_fbb;
   uint64_t sequence = 0;
+  // This process's id on its batches (TransitionBatch.writer): shards store a batch once. Drawn
+  // from the OS, not the seed: two actors started with one seed must still differ.
+  const uint64_t writer = draw_writer_id();
 
   // Timing and state of the control plane.
   const std::atomic<bool>* stop = nullptr;
@@ -284,6 +299,7 @@ struct ActorLoop::Impl {
   Clock::time_point next_control, next_heartbeat, next_tick, learner_heard, rejoin_sent, last_malformed_log;
   bool rejoin_pending = false;
   bool learner_silent = false;
+  net::PeerCounters* learner_peer = &counters.peers.peer("learner");
   bool waiting_for_shards_logged = false;
 };
 
@@ -319,6 +335,7 @@ ActorLoop::Impl::Impl(net::Context& c, LearnerLink l, const ClusterInfo& map,
   }
   sub.subscribe_all();
   counters.malformed_messages.fetch_add(link.malformed_during_join(), std::memory_order_relaxed);
+  link.count_traffic(learner_peer);
   apply_map(map);
 }
 
@@ -446,6 +463,7 @@ bool ActorLoop::Impl::try_send(size_t index, std::span<const uint8_t> bytes, int
   if (!s.dealer.send(bytes, timeout_ms)) {
     return false;
   }
+  s.peer->sent(bytes.size());
   if (s.skipped_until) {
     log::info("actor {}: shard {} accepts batches again", actor_index, s.endpoint);
   }
@@ -478,7 +496,7 @@ void ActorLoop::Impl::add_rows(const EpisodeBuffer& ep, OutgoingBatch& b, uint8_
 }
 
 void ActorLoop::Impl::send_batch(OutgoingBatch& b, uint8_t table) {
-  wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table);
+  wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table, writer);
   const std::span<const uint8_t> bytes = wire::bytes_of(batch_fbb);
   while (!stop->load(std::memory_order_relaxed)) {
     const auto now = Clock::now();
@@ -561,7 +579,8 @@ void ActorLoop::Impl::wait_for_acks() {
 
 void ActorLoop::Impl::read_acks() {
   for (Shard& s : shards) {
-    if (s.connection.take() > 0 && !s.unacked.empty()) {
+    const int disconnects = s.connection.take();
+    if (disconnects > 0 && !s.unacked.empty()) {
       // The shard's end of the connection died (killed, or restarted on the same endpoint): what
       // it had not acknowledged is gone, and it will not be acknowledged.
       log::warn("actor {}: lost the connection to shard {}; its {} unacknowledged batches are lost", actor_index,
@@ -569,12 +588,17 @@ void ActorLoop::Impl::read_acks() {
       counters.batches_lost.fetch_add(static_cast<int64_t>(s.unacked.size()), std::memory_order_relaxed);
       s.unacked.clear();
     }
+    for (int n = 0; n < disconnects; ++n) {
+      s.peer->reconnected();  // libzmq connects again by itself
+    }
     for (int n = 0; n < kMaxMessagesPerLook && s.dealer.recv(junk, 0); ++n) {
+      s.peer->received(junk.size());
       const wire::Envelope* env = wire::open_envelope(junk.bytes());
       if (env == nullptr || env->payload_type() != wire::Payload::InsertAck) {
         note_malformed("a shard sent something other than an InsertAck");
         continue;
       }
+      counters.transitions_acknowledged.fetch_add(env->payload_as_InsertAck()->inserted(), std::memory_order_relaxed);
       const size_t retired = s.unacked.acknowledge(env->payload_as_InsertAck()->sequence());
       if (retired > 0) {
         s.last_progress = Clock::now();
@@ -589,7 +613,7 @@ void ActorLoop::Impl::final_flush() {
     if (b.empty()) {
       return;
     }
-    wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table);
+    wire::build_transition_batch(batch_fbb, actor_index, sequence, b.rows(), table, writer);
     for (size_t j = 0; j < shards.size(); ++j) {
       if (try_send((next_shard + j) % shards.size(), wire::bytes_of(batch_fbb), config.send_attempt_ms, b)) {
         return;
@@ -697,6 +721,7 @@ void ActorLoop::Impl::poll_weights() {
     if (!sub.recv(weights_msg[static_cast<size_t>(slot)], 0)) {
       break;
     }
+    learner_peer->received(weights_msg[static_cast<size_t>(slot)].size());
     if (check_weights(weights_msg[static_cast<size_t>(slot)].bytes()) != nullptr) {
       pending = slot;
     }
@@ -750,6 +775,7 @@ void ActorLoop::Impl::heard_learner(Clock::time_point now) {
   if (learner_silent) {
     log::info("actor {}: the learner answers again", actor_index);
     learner_silent = false;
+    learner_peer->reconnected();  // silent past the peer timeout, then back
   }
 }
 
@@ -822,6 +848,7 @@ void ActorLoop::Impl::apply_map(const ClusterInfo& map) {
         s.dealer.make_curve_client(*config.curve);
       }
       s.dealer.connect(ep);
+      s.peer = &counters.peers.peer("replay:" + ep);
       next.push_back(std::move(s));
       log::info("actor {}: sending to shard {}", actor_index, ep);
     } catch (const std::runtime_error& e) {

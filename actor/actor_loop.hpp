@@ -47,6 +47,7 @@
 
 #include "actor/exploration.hpp"
 #include "actor/learner_link.hpp"
+#include "core/peer_stats.hpp"
 #include "core/policy.hpp"
 #include "core/transport.hpp"
 #include "envs/env.hpp"
@@ -91,13 +92,16 @@ struct ActorCounters {
   std::atomic<int64_t> weights_version{0};  // 0 = no weights yet (acting with ε = 1)
   std::atomic<int64_t> malformed_messages{0};
   std::atomic<int64_t> send_blocked_ms{0};
-  std::atomic<int64_t> batches_acknowledged{0};  // InsertAcks' worth: batches the shards have read
-  std::atomic<int64_t> batches_lost{0};          // unacknowledged when their shard's connection died
-  std::atomic<int64_t> reports_dropped{0};       // EpisodeReports the join socket would not take
-  std::atomic<double> epsilon{1.0};              // ε the next step uses
+  std::atomic<int64_t> batches_acknowledged{0};      // InsertAcks' worth: batches the shards have read
+  std::atomic<int64_t> transitions_acknowledged{0};  // transitions the shards said they stored (InsertAck.inserted)
+  std::atomic<int64_t> batches_lost{0};              // unacknowledged when their shard's connection died
+  std::atomic<int64_t> reports_dropped{0};           // EpisodeReports the join socket would not take
+  std::atomic<double> epsilon{1.0};                  // ε the next step uses
   // Learner updates between the weights this actor acts with and the newest update count it has
   // heard of (heartbeat answers, weights); 0 before the first weights.
   std::atomic<int64_t> weights_age_updates{0};
+  // Traffic and liveness per peer: "learner" (join socket and weights) and "replay:ENDPOINT".
+  net::PeerTable peers;
 };
 
 class ActorLoop {

@@ -1,5 +1,7 @@
 #include "actor/learner_link.hpp"
 
+#include "core/peer_stats.hpp"
+
 #include <chrono>
 #include <utility>
 
@@ -61,6 +63,18 @@ struct LearnerLink::Impl {
   net::Message msg;
   int64_t malformed_during_join = 0;
   int64_t learner_updates = 0;
+  net::PeerCounters* peer = nullptr;  // count_traffic()
+
+  bool send() {
+    const std::span<const uint8_t> bytes = wire::bytes_of(fbb);
+    if (!dealer.send(bytes, 0)) {
+      return false;
+    }
+    if (peer != nullptr) {
+      peer->sent(bytes.size());
+    }
+    return true;
+  }
 
   Impl(net::Context& c, LearnerLinkConfig cfg) : ctx(&c), config(std::move(cfg)), dealer(make_dealer(c, config)) {}
 };
@@ -77,6 +91,10 @@ const LearnerLinkConfig& LearnerLink::config() const {
 int64_t LearnerLink::learner_updates() const {
   return impl_->learner_updates;
 }
+void LearnerLink::count_traffic(net::PeerCounters* peer) {
+  impl_->peer = peer;
+}
+
 int64_t LearnerLink::malformed_during_join() const {
   return impl_->malformed_during_join;
 }
@@ -84,18 +102,18 @@ int64_t LearnerLink::malformed_during_join() const {
 bool LearnerLink::send_join_request() {
   wire::build_join_request(impl_->fbb, wire::Role::Actor, impl_->config.name, "", "", impl_->config.actor_envs,
                            impl_->config.metrics_url);
-  return impl_->dealer.send(wire::bytes_of(impl_->fbb), 0);
+  return impl_->send();
 }
 
 bool LearnerLink::send_heartbeat(uint64_t map_version, std::span<const int64_t> counters) {
   wire::build_heartbeat(impl_->fbb, wire::Role::Actor, impl_->config.name, map_version, counters);
-  return impl_->dealer.send(wire::bytes_of(impl_->fbb), 0);
+  return impl_->send();
 }
 
 bool LearnerLink::send_episode_report(uint32_t actor_id, uint64_t episode, float ret, uint32_t steps, int32_t status,
                                       uint64_t policy_version, bool scripted) {
   wire::build_episode_report(impl_->fbb, actor_id, episode, ret, steps, status, policy_version, scripted);
-  return impl_->dealer.send(wire::bytes_of(impl_->fbb), 0);
+  return impl_->send();
 }
 
 bool LearnerLink::wait_readable(int timeout_ms) {
@@ -105,6 +123,9 @@ bool LearnerLink::wait_readable(int timeout_ms) {
 LearnerLink::Received LearnerLink::receive(ClusterInfo& map, uint64_t& learner_map_version) {
   if (!impl_->dealer.recv(impl_->msg, 0)) {
     return Received::kNothing;
+  }
+  if (impl_->peer != nullptr) {
+    impl_->peer->received(impl_->msg.size());
   }
   const wire::Envelope* env = wire::open_envelope(impl_->msg.bytes());
   if (env == nullptr) {

@@ -24,6 +24,9 @@
 #include "core/transport.hpp"
 
 namespace pamdp {
+namespace net {
+struct PeerCounters;
+}
 
 // What an actor needs from a ClusterMap, copied out of the received buffer.
 struct ClusterInfo {
@@ -78,6 +81,8 @@ class LearnerLink {
 
   // The learner's update count in its newest heartbeat answer (0 before the first).
   [[nodiscard]] int64_t learner_updates() const;
+  // Counts every message sent and received from now on into `peer` (may be nullptr: stop).
+  void count_traffic(net::PeerCounters* peer);
   // Malformed messages seen by join() (receive() leaves the counting to its caller).
   [[nodiscard]] int64_t malformed_during_join() const;
   [[nodiscard]] const LearnerLinkConfig& config() const;

@@ -135,6 +135,7 @@ void run_actor(const ActorCliOptions& o) {
   loop_config.demo_table = config.ddpg.demo_bc_weight > 0.0;
 
   ActorMetrics actor_metrics(endpoint.registry(), counters, *envs.front());
+  register_peer_metrics(endpoint.registry(), counters.peers);
   ActorLoop loop(ctx, std::move(link), *map, std::move(envs), loop_config, counters);
   loop.on_episode = [&actor_metrics](int status, double ret, int steps) {
     actor_metrics.on_episode(status, ret, steps);

@@ -130,6 +130,7 @@ void run_learner(const LearnerCliOptions& o) {
                              "=tcp://127.0.0.1:PORT (port 0: any free port; deploy/local-cluster.sh: --port)");
   }
   LearnerServer& server = *bound;
+  register_peer_metrics(endpoint.registry(), server.peers());
   g_server = &server;
   std::signal(SIGINT, on_learner_signal);
   std::signal(SIGTERM, on_learner_signal);

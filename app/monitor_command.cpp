@@ -37,6 +37,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr size_t kHistory = 60;  // sparkline points (one per refresh)
+// A peer silent this long is marked (pamdp_peer_silence_seconds). Peers send heartbeats every
+// cluster.heartbeat_ms (1 s by default), so with one refresh a second a peer that falls silent is
+// marked within about 4 s.
+constexpr double kSilentSeconds = 3.0;
 
 std::atomic<bool> g_quit{false};
 extern "C" void on_monitor_signal(int /*sig*/) {
@@ -357,6 +361,31 @@ View build_view(const std::vector<Target>& ts, std::vector<double>& return_histo
   for (const auto& [r, n] : roles) {
     role_list += (role_list.empty() ? "" : ", ") + r + " " + std::to_string(n);
   }
+  // Silent links, as the learner sees its peers and as each process sees the learner. (A shard's
+  // view of an actor is left out: a shard holding inserts back reads nothing for a while.)
+  nlohmann::json silent = nlohmann::json::array();
+  std::string silent_list;
+  for (const Target& t : ts) {
+    if (!t.up) {
+      continue;
+    }
+    const std::string prefix = "pamdp_peer_silence_seconds{peer=\"";
+    for (const auto& [key, value] : t.now) {
+      if (key.rfind(prefix, 0) != 0 || value < kSilentSeconds) {
+        continue;
+      }
+      const std::string peer = key.substr(prefix.size(), key.size() - prefix.size() - 2);
+      if (t.role != "learner" && peer != "learner") {
+        continue;
+      }
+      silent.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"silence_s", value}});
+      if (silent.size() <= 6) {
+        silent_list += (silent_list.empty() ? "" : ", ") + t.role + " -> " + peer + " " + num(value, 1) + " s";
+      }
+    }
+  }
+  j["silent_peers"] = silent;
+
   auto& L = v.lines;
   L.push_back("pamdp monitor: " + std::to_string(up) + "/" + std::to_string(ts.size()) + " targets up (" + role_list +
               ")");
@@ -372,6 +401,8 @@ View build_view(const std::vector<Target>& ts, std::vector<double>& return_histo
               " | params at bound " + num(at_bound * 100.0, 1) + " %");
   L.push_back("episodes    " + num(episodes) + " | goal rate (last 100) " + sig(goal_rate) +
               " | mean return (last 100) " + sig(mean_return) + " | bad messages " + num(bad));
+  L.push_back("links       " + (silent.empty() ? std::string("no silent peer")
+                                               : "SILENT " + std::to_string(silent.size()) + ": " + silent_list));
   L.push_back("return      " + sparkline(return_history));
   L.push_back("goal rate   " + sparkline(goal_history));
   L.push_back("");

@@ -104,6 +104,7 @@ void run_replay(const ReplayCliOptions& o) {
   }
   ShardServer& server = *bound;
   register_shard_metrics(endpoint->registry(), server);
+  register_peer_metrics(endpoint->registry(), server.peers());
   // The endpoint's scrapes read the server: stop serving them before the server goes.
   const struct StopMetricsFirst {
     std::unique_ptr<MetricsEndpoint>& e;

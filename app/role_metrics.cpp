@@ -1,6 +1,9 @@
 #include "app/role_metrics.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <memory>
+#include <mutex>
 #include <string_view>
 
 #include "core/files.hpp"
@@ -144,6 +147,10 @@ ActorMetrics::ActorMetrics(Registry& r, const ActorCounters& c, const Env& env) 
                                 "Time the env loop waited for a shard to take a batch (backpressure)");
   Counter* acked = &r.counter("pamdp_actor_batches_acknowledged_total",
                               "TransitionBatches the replay shards have acknowledged (read)");
+  Counter* acked_transitions =
+      &r.counter("pamdp_actor_transitions_acknowledged_total",
+                 "Transitions the replay shards acknowledged as stored (InsertAck.inserted); each is in a shard's "
+                 "table or counted there as evicted");
   Counter* lost = &r.counter("pamdp_actor_batches_lost_total",
                              "TransitionBatches unacknowledged when the connection to their shard died");
   Counter* dropped =
@@ -161,6 +168,7 @@ ActorMetrics::ActorMetrics(Registry& r, const ActorCounters& c, const Env& env) 
     batches->set(c.batches_sent.load(rl));
     blocked->set(c.send_blocked_ms.load(rl) / 1000);
     acked->set(c.batches_acknowledged.load(rl));
+    acked_transitions->set(c.transitions_acknowledged.load(rl));
     lost->set(c.batches_lost.load(rl));
     dropped->set(c.reports_dropped.load(rl));
     bad->set(c.malformed_messages.load(rl));
@@ -194,6 +202,12 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
   Gauge* fill = &r.gauge("pamdp_replay_fill_ratio", "Transitions held / capacity");
   Gauge* restored =
       &r.gauge("pamdp_replay_restored_transitions", "Transitions restored from the snapshot at start (--snapshot)");
+  Counter* evicted =
+      &r.counter("pamdp_replay_transitions_evicted_total",
+                 "Transitions gone by the table's rule: overwritten when full, or dropped with the table "
+                 "on a new capacity (inserted + restored = size + evicted)");
+  Counter* duplicates = &r.counter("pamdp_replay_batches_duplicate_total",
+                                   "Batches refused because the same writer's batch was stored already");
   r.on_collect([=, &server] {
     const ShardCounters c = server.counters();
     inserted->set(c.inserted);
@@ -211,9 +225,56 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
     capacity->set(static_cast<double>(c.capacity));
     fill->set(c.capacity > 0 ? static_cast<double>(c.size) / static_cast<double>(c.capacity) : 0.0);
     restored->set(static_cast<double>(c.restored));
+    evicted->set(c.evicted);
+    duplicates->set(c.batches_duplicate);
   });
   register_rate(r, *inserted, "pamdp_replay_inserts_per_second", "Transitions stored per second");
   register_rate(r, *sampled, "pamdp_replay_samples_per_second", "Transitions sampled per second");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void register_peer_metrics(Registry& r, net::PeerTable& table) {
+  struct Series {
+    const net::PeerCounters* peer;
+    Counter* messages_in;
+    Counter* bytes_in;
+    Counter* messages_out;
+    Counter* bytes_out;
+    Counter* reconnects;
+    Gauge* silence;
+  };
+  struct State {
+    std::mutex mutex;
+    std::vector<Series> series;
+  };
+  auto state = std::make_shared<State>();
+  table.watch([&r, state](net::PeerCounters& p) {
+    const metrics::Labels l{{"peer", p.name}};
+    Series s{&p,
+             &r.counter("pamdp_peer_messages_received_total", "Messages received from the peer", l),
+             &r.counter("pamdp_peer_bytes_received_total", "Bytes received from the peer", l),
+             &r.counter("pamdp_peer_messages_sent_total", "Messages sent to the peer", l),
+             &r.counter("pamdp_peer_bytes_sent_total", "Bytes sent to the peer", l),
+             &r.counter("pamdp_peer_reconnects_total",
+                        "Connections to the peer lost and made again, or joins from a new connection", l),
+             &r.gauge("pamdp_peer_silence_seconds", "Seconds since the peer's last message (-1: none yet)", l)};
+    const std::lock_guard lock(state->mutex);
+    state->series.push_back(s);
+  });
+  r.on_collect([state] {
+    const auto now = std::chrono::steady_clock::now();
+    constexpr auto rl = std::memory_order_relaxed;
+    const std::lock_guard lock(state->mutex);
+    for (const Series& s : state->series) {
+      s.messages_in->set(s.peer->messages_in.load(rl));
+      s.bytes_in->set(s.peer->bytes_in.load(rl));
+      s.messages_out->set(s.peer->messages_out.load(rl));
+      s.bytes_out->set(s.peer->bytes_out.load(rl));
+      s.reconnects->set(s.peer->reconnects.load(rl));
+      s.silence->set(s.peer->silence_seconds(now));
+    }
+  });
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -21,6 +21,7 @@
 #include "actor/actor_loop.hpp"
 #include "core/metrics.hpp"
 #include "core/metrics_http.hpp"
+#include "core/peer_stats.hpp"
 #include "envs/env.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/evaluation.hpp"
@@ -113,6 +114,13 @@ class ActorMetrics {
 // `pamdp replay`: copies ShardServer::counters() when scraped. `server` must outlive the registry's
 // last render (destroy the endpoint first).
 void register_shard_metrics(metrics::Registry& r, const ShardServer& server);
+
+// Per-peer series of a PeerTable (core/peer_stats.hpp), each labelled peer="NAME":
+//   pamdp_peer_messages_received_total, pamdp_peer_bytes_received_total,
+//   pamdp_peer_messages_sent_total, pamdp_peer_bytes_sent_total, pamdp_peer_reconnects_total,
+//   pamdp_peer_silence_seconds (since its last message; -1 before the first).
+// Watches the table (PeerTable::watch): its peers now and later. Both must outlive the registry's use.
+void register_peer_metrics(metrics::Registry& r, net::PeerTable& table);
 
 // `pamdp learner`: update statistics, episode reports and the once-a-second counters.
 class LearnerMetrics {

@@ -107,6 +107,20 @@ Socket::Socket(Context& ctx, SocketType type) : sock_(zmq_socket(ctx.raw(), zmq_
   }
   const int linger = 0;
   zmq_setsockopt(sock_, ZMQ_LINGER, &linger, sizeof(linger));
+  // Liveness on real links (docs/reliability.md, "Faults: a bad network"). A link that drops
+  // packets without a FIN or RST (a partition, a vanished host) leaves TCP's connection open,
+  // and its retransmissions back off to tens of seconds: without these a link healed after 30 s
+  // could stay silent 20 s longer. ZMTP heartbeats close a connection that has been silent for
+  // kHeartbeatTimeoutMs, so libzmq reconnects; a connect that gets no answer is abandoned after
+  // kConnectTimeoutMs and retried every ZMQ_RECONNECT_IVL (100 ms), so a healed link is used
+  // again within about kConnectTimeoutMs. The timeout is generous because a peer that holds its
+  // socket unread (backpressure) leaves pings unread too. inproc:// ignores all three.
+  const int heartbeat_ivl = kHeartbeatIntervalMs;
+  const int heartbeat_timeout = kHeartbeatTimeoutMs;
+  const int connect_timeout = kConnectTimeoutMs;
+  zmq_setsockopt(sock_, ZMQ_HEARTBEAT_IVL, &heartbeat_ivl, sizeof(heartbeat_ivl));
+  zmq_setsockopt(sock_, ZMQ_HEARTBEAT_TIMEOUT, &heartbeat_timeout, sizeof(heartbeat_timeout));
+  zmq_setsockopt(sock_, ZMQ_CONNECT_TIMEOUT, &connect_timeout, sizeof(connect_timeout));
 }
 
 Socket::~Socket() {

@@ -64,6 +64,14 @@ struct CurveClientKeys {
   std::string server_public_key;
 };
 
+// Liveness of every socket's TCP connections (set by the Socket constructor): a ZMTP ping every
+// kHeartbeatIntervalMs; a connection silent for kHeartbeatTimeoutMs is closed and libzmq
+// reconnects; a connect unanswered for kConnectTimeoutMs is retried. So a link that comes back
+// after a partition is in use again within about kConnectTimeoutMs + 100 ms.
+inline constexpr int kHeartbeatIntervalMs = 1000;
+inline constexpr int kHeartbeatTimeoutMs = 10000;
+inline constexpr int kConnectTimeoutMs = 2000;
+
 class Socket {
  public:
   Socket(Context& ctx, SocketType type);

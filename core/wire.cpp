@@ -23,7 +23,8 @@ bool all_finite(const flatbuffers::Vector<float>* v) {
 }
 
 flatbuffers::Offset<TransitionBatch> batch_offset(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id,
-                                                  uint64_t sequence, const TransitionRows& r, uint8_t table = 0) {
+                                                  uint64_t sequence, const TransitionRows& r, uint8_t table = 0,
+                                                  uint64_t writer = 0) {
   const size_t n = r.count;
   const auto states = fbb.CreateVector(r.states, n * r.obs_dim);
   const auto actions = fbb.CreateVector(r.actions, n * r.action_dim);
@@ -32,7 +33,7 @@ flatbuffers::Offset<TransitionBatch> batch_offset(flatbuffers::FlatBufferBuilder
   const auto terminals = fbb.CreateVector(r.terminals, n);
   const auto returns = fbb.CreateVector(r.mc_returns, n);
   return CreateTransitionBatch(fbb, actor_id, sequence, r.obs_dim, r.action_dim, r.count, states, actions, rewards,
-                               next_states, terminals, returns, table);
+                               next_states, terminals, returns, table, writer);
 }
 
 }  // namespace
@@ -118,9 +119,9 @@ void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, co
 }
 
 void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
-                            const TransitionRows& rows, uint8_t table) {
+                            const TransitionRows& rows, uint8_t table, uint64_t writer) {
   fbb.Clear();
-  finish(fbb, Payload::TransitionBatch, batch_offset(fbb, actor_id, sequence, rows, table).Union());
+  finish(fbb, Payload::TransitionBatch, batch_offset(fbb, actor_id, sequence, rows, table, writer).Union());
 }
 
 void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size,

@@ -58,8 +58,9 @@ void build_cluster_map(flatbuffers::FlatBufferBuilder& fbb, uint64_t version, co
 inline constexpr uint8_t kReplayTable = 0;
 inline constexpr uint8_t kDemoTable = 1;
 
+// writer: the sending process's random id (TransitionBatch.writer); 0 opts out of deduplication.
 void build_transition_batch(flatbuffers::FlatBufferBuilder& fbb, uint32_t actor_id, uint64_t sequence,
-                            const TransitionRows& rows, uint8_t table = kReplayTable);
+                            const TransitionRows& rows, uint8_t table = kReplayTable, uint64_t writer = 0);
 // demo_batch_size > 0: the shard also sends that many demonstrations when it holds any.
 void build_sample_request(flatbuffers::FlatBufferBuilder& fbb, uint64_t request_id, uint32_t batch_size,
                           uint32_t demo_batch_size = 0);

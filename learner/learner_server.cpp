@@ -21,6 +21,7 @@ struct LearnerServer::Shard {
   int in_flight = 0;
   std::chrono::steady_clock::time_point last_heard;
   int64_t samples = 0;
+  net::PeerCounters* traffic = nullptr;  // the peer it joined as ("replay:NAME")
   Shard(net::Context& ctx) : dealer(ctx, net::SocketType::kDealer) {}
 };
 
@@ -74,7 +75,16 @@ void LearnerServer::send_map(std::span<const uint8_t> identity, uint32_t actor_i
   }
   wire::build_cluster_map(fbb_->fbb, map_version_, config_.config_toml, inserts, samples, weights_endpoint_,
                           actor_index, next_actor_index_, static_cast<uint64_t>(counters_.weights_version));
-  join_.send_to(identity, wire::bytes_of(fbb_->fbb), 100);
+  if (join_.send_to(identity, wire::bytes_of(fbb_->fbb), 100)) {
+    count_sent(identity, wire::bytes_of(fbb_->fbb).size());
+  }
+}
+
+void LearnerServer::count_sent(std::span<const uint8_t> identity, size_t bytes) {
+  const auto peer = peers_.find(std::string(reinterpret_cast<const char*>(identity.data()), identity.size()));
+  if (peer != peers_.end() && peer->second.traffic != nullptr) {
+    peer->second.traffic->sent(bytes);
+  }
 }
 
 void LearnerServer::publish_weights() {
@@ -98,6 +108,25 @@ void LearnerServer::handle_join_socket() {
     }
     const std::vector<uint8_t> id(identity.data(), identity.data() + identity.size());
     const std::string peer_id(reinterpret_cast<const char*>(identity.data()), identity.size());
+    net::PeerCounters* traffic = nullptr;
+    if (const auto p = peers_.find(peer_id); p != peers_.end()) {
+      traffic = p->second.traffic;
+    }
+    if (traffic == nullptr && env->payload_type() == wire::Payload::JoinRequest) {
+      // A peer is named by the role and name it joins with; the same name on a new connection
+      // is the same peer reconnected (after a partition, or a restart under the same name).
+      const auto* j = env->payload_as_JoinRequest();
+      const std::string name = std::string(j->role() == wire::Role::Shard ? "replay:" : "actor:") +
+                               (j->name() != nullptr ? j->name()->str() : "?");
+      const bool seen = peers_table_.knows(name);
+      traffic = &peers_table_.peer(name);
+      if (seen) {
+        traffic->reconnected();
+      }
+    }
+    if (traffic != nullptr) {
+      traffic->received(payload.size());
+    }
     switch (env->payload_type()) {
       case wire::Payload::JoinRequest: {
         const auto* j = env->payload_as_JoinRequest();
@@ -131,7 +160,8 @@ void LearnerServer::handle_join_socket() {
           }
           (*it)->join_identity = id;
           (*it)->last_heard = Clock::now();
-          peers_[peer_id] = {false, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now()};
+          (*it)->traffic = traffic;
+          peers_[peer_id] = {false, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now(), traffic};
           refresh_peers(false);
           send_map(identity.bytes(), 0);
         } else if (j->role() == wire::Role::Actor) {
@@ -143,7 +173,7 @@ void LearnerServer::handle_join_socket() {
             log::info("learner: actor {} joined ({}, {} envs)", known->second, j->name() ? j->name()->str() : "?",
                       j->actor_envs());
           }
-          peers_[peer_id] = {true, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now()};
+          peers_[peer_id] = {true, j->metrics_url() != nullptr ? j->metrics_url()->str() : "", Clock::now(), traffic};
           refresh_peers(false);
           send_map(identity.bytes(), known->second);
           // The newcomer subscribes only after it has the map: publish again shortly.
@@ -168,7 +198,9 @@ void LearnerServer::handle_join_socket() {
         // version 0, which never matches, so the peer joins again.
         const int64_t c[] = {counters_.updates, counters_.weights_version};
         wire::build_heartbeat(fbb_->fbb, wire::Role::Learner, "learner", known ? map_version_ : 0, c);
-        join_.send_to(identity.bytes(), wire::bytes_of(fbb_->fbb), 0);
+        if (join_.send_to(identity.bytes(), wire::bytes_of(fbb_->fbb), 0) && traffic != nullptr) {
+          traffic->sent(wire::bytes_of(fbb_->fbb).size());
+        }
         break;
       }
       case wire::Payload::EpisodeReport: {
@@ -232,6 +264,9 @@ void LearnerServer::request_samples(Shard& shard) {
     if (!shard.dealer.send(wire::bytes_of(fbb_->fbb), 0)) {
       return;
     }
+    if (shard.traffic != nullptr) {
+      shard.traffic->sent(wire::bytes_of(fbb_->fbb).size());
+    }
     ++shard.in_flight;
   }
 }
@@ -266,6 +301,9 @@ const Sample* LearnerServer::take_reply(Shard& shard) {
   }
   shard.in_flight = std::max(0, shard.in_flight - 1);
   shard.last_heard = Clock::now();
+  if (shard.traffic != nullptr) {
+    shard.traffic->received(msg.size());
+  }
   const wire::Envelope* env = wire::open_envelope(msg.bytes());
   if (env == nullptr || env->payload_type() != wire::Payload::SampleReply) {
     note_malformed("shard reply is not a SampleReply");

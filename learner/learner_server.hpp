@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/peer_stats.hpp"
 #include "core/transport.hpp"
 #include "learner/algorithm.hpp"
 #include "learner/sampler.hpp"
@@ -111,6 +112,9 @@ class LearnerServer final : public Sampler {
   // to `pamdp monitor` (MetricsUrlsRequest). Learner thread only.
   [[nodiscard]] const std::vector<std::string>& metrics_urls() const { return metrics_urls_; }
   void publish_weights();
+  // Traffic and liveness per peer ("actor:NAME", "replay:NAME"), for /metrics; counted on the
+  // learner thread.
+  [[nodiscard]] net::PeerTable& peers() { return peers_table_; }
 
  private:
   struct Shard;
@@ -119,6 +123,7 @@ class LearnerServer final : public Sampler {
     bool actor = false;
     std::string metrics_url;
     std::chrono::steady_clock::time_point last_heard;
+    net::PeerCounters* traffic = nullptr;  // in peers_table_, by the name it joined with
   };
   void handle_join_socket();
   void refresh_peers(bool drop_silent);
@@ -133,6 +138,7 @@ class LearnerServer final : public Sampler {
   // After shards_ changed: a new map version, and the shard count the counters report.
   void shards_changed();
   void send_map(std::span<const uint8_t> identity, uint32_t actor_index);
+  void count_sent(std::span<const uint8_t> identity, size_t bytes);
   void note_malformed(const char* what);
 
   net::Context& ctx_;
@@ -158,6 +164,7 @@ class LearnerServer final : public Sampler {
   net::Message reply_;
   std::optional<std::chrono::steady_clock::time_point> republish_at_;
   std::map<std::string, Peer> peers_;  // by join-socket identity (bytes)
+  net::PeerTable peers_table_;
   std::vector<std::string> metrics_urls_;
   // The sampling loop's state between next() calls: one poll is a round, whose readable shards
   // are read in turn, one reply per call.

@@ -191,6 +191,7 @@ ShardServer::ShardServer(net::Context& ctx, ShardServerOptions options, ShardCon
   if (!config_from_map_) {
     misuse("ShardServer needs a config_from_map function");
   }
+  writers_.reserve(kMaxWriters);
   if (options_.join_endpoint.empty()) {
     throw std::runtime_error("replay shard: no learner join endpoint given (e.g. --join tcp://LEARNER:5555)");
   }
@@ -251,6 +252,8 @@ ShardCounters ShardServer::counters() const {
   c.capacity = capacity_.load(r);
   c.inserts_held = inserts_held_pub_.load(r);
   c.restored = restored_.load(r);
+  c.evicted = evicted_.load(r);
+  c.batches_duplicate = batches_duplicate_.load(r);
   c.connections_refused = handshakes_.refused();
   return c;
 }
@@ -292,6 +295,10 @@ void ShardServer::run() {
         send_heartbeat(now);
       }
       if (now - last_heard_learner_ > std::chrono::milliseconds(peer_timeout_ms_) && now >= next_join_) {
+        if (!learner_silent_) {
+          learner_silent_ = true;
+          learner_->reconnected();  // counted when it goes silent; it answers again or stays silent
+        }
         if (log_silent_.open(now)) {
           log::warn("replay shard '{}': no word from the learner for {} ms; joining again", options_.name,
                     to_ms(now - last_heard_learner_));
@@ -348,7 +355,9 @@ void ShardServer::run() {
 void ShardServer::send_join(Clock::time_point now) {
   wire::build_join_request(fbb_, wire::Role::Shard, options_.name, insert_endpoint_, sample_endpoint_, 0,
                            options_.metrics_url);
-  join_.send(wire::bytes_of(fbb_), 0);  // a full queue means the learner is away: the retry covers it
+  if (join_.send(wire::bytes_of(fbb_), 0)) {  // a full queue means the learner is away: the retry covers it
+    learner_->sent(wire::bytes_of(fbb_).size());
+  }
   next_join_ = now + std::chrono::milliseconds(joined_ ? heartbeat_ms_ : options_.join_retry_ms);
 }
 
@@ -361,12 +370,16 @@ void ShardServer::send_heartbeat(Clock::time_point now) {
   hb_counters_[kHbBlockedMs] = to_ms(blocked_);
   hb_counters_[kHbSize] = shard_ != nullptr ? shard_->buffer().size() : 0;
   wire::build_heartbeat(fbb_, wire::Role::Shard, options_.name, map_version_, hb_counters_);
-  join_.send(wire::bytes_of(fbb_), 0);
+  if (join_.send(wire::bytes_of(fbb_), 0)) {
+    learner_->sent(wire::bytes_of(fbb_).size());
+  }
   next_heartbeat_ = now + std::chrono::milliseconds(heartbeat_ms_);
 }
 
 void ShardServer::read_join_socket(Clock::time_point now) {
   for (int i = 0; i < kDrainBudget && join_.recv(frame_, 0); ++i) {
+    learner_->received(frame_.size());
+    learner_silent_ = false;
     const wire::Envelope* env = wire::open_envelope(frame_.bytes());
     if (env == nullptr) {
       malformed(log_join_, "join", "not a verified envelope of this schema", now);
@@ -430,7 +443,9 @@ void ShardServer::take_cluster_map(const wire::ClusterMap& map, Clock::time_poin
         "dropping the {} stored transitions",
         options_.name, shard_->config().capacity, shard_->config().obs_dim, shard_->config().action_dim,
         config.capacity, config.obs_dim, config.action_dim, shard_->buffer().size());
+    evicted_.fetch_add(static_cast<int64_t>(shard_->buffer().size()), std::memory_order_relaxed);
     shard_ = std::make_unique<ReplayShard>(config, max_sample);
+    size_.store(0, std::memory_order_relaxed);
   } else if (!(config.limiter == shard_->config().limiter)) {
     shard_->set_limiter_config(config.limiter);
   }
@@ -466,7 +481,10 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
       continue;
     }
     // Every batch read is acknowledged, stored or not, so that its actor's window moves on.
+    net::PeerCounters& actor = actor_peer(batch->actor_id());
+    actor.received(frame_.size());
     acknowledge(batch->sequence(), insert_batch(*batch, obs, act, now));
+    actor.sent(ack_fbb_.GetSize());
   }
 }
 
@@ -490,10 +508,68 @@ uint32_t ShardServer::insert_batch(const wire::TransitionBatch& batch, uint32_t 
     malformed(log_insert_, "insert", "TransitionBatch for a table that does not exist", now);
     return 0;
   }
+  if (duplicate(batch.writer(), batch.sequence(), now)) {
+    return 0;
+  }
+  const auto before = static_cast<int64_t>(shard_->buffer().size());
   shard_->insert(wire::rows_of(&batch));
+  const auto after = static_cast<int64_t>(shard_->buffer().size());
+  mark_stored(batch.writer(), batch.sequence());
   inserted_.fetch_add(batch.count(), std::memory_order_relaxed);
-  size_.store(shard_->buffer().size(), std::memory_order_relaxed);
+  evicted_.fetch_add(before + static_cast<int64_t>(batch.count()) - after, std::memory_order_relaxed);
+  size_.store(after, std::memory_order_relaxed);
   return batch.count();
+}
+
+net::PeerCounters& ShardServer::actor_peer(uint32_t actor_id) {
+  // "actor:#INDEX" (the learner's actor index; the learner names actors by host and pid), built
+  // in a fixed buffer: the lookup allocates only the first time an actor is seen.
+  std::array<char, 32> name{};
+  const int n = std::snprintf(name.data(), name.size(), "actor:#%u", actor_id);
+  return peers_.peer(std::string_view(name.data(), static_cast<size_t>(n)));
+}
+
+bool ShardServer::duplicate(uint64_t writer, uint64_t sequence, Clock::time_point now) {
+  if (writer == 0) {
+    return false;  // an actor from before TransitionBatch.writer
+  }
+  for (const WriterMark& m : writers_) {
+    if (m.writer == writer) {
+      if (sequence > m.sequence) {
+        return false;
+      }
+      const int64_t total = batches_duplicate_.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (log_duplicate_.open(now)) {
+        log::warn("replay shard '{}': refused a batch stored already (writer {:016x}, sequence {} <= {}); {} in all",
+                  options_.name, writer, sequence, m.sequence, total);
+      }
+      return true;
+    }
+  }
+  return false;
+}
+
+void ShardServer::mark_stored(uint64_t writer, uint64_t sequence) {
+  if (writer == 0) {
+    return;
+  }
+  ++batches_seen_;
+  WriterMark* oldest = nullptr;
+  for (WriterMark& m : writers_) {
+    if (m.writer == writer) {
+      m.sequence = sequence;
+      m.last_seen = batches_seen_;
+      return;
+    }
+    if (oldest == nullptr || m.last_seen < oldest->last_seen) {
+      oldest = &m;
+    }
+  }
+  if (writers_.size() < kMaxWriters) {
+    writers_.push_back({writer, sequence, batches_seen_});  // within the reserved capacity
+  } else {
+    *oldest = {writer, sequence, batches_seen_};
+  }
 }
 
 void ShardServer::acknowledge(uint64_t sequence, uint32_t inserted) {
@@ -507,6 +583,7 @@ void ShardServer::acknowledge(uint64_t sequence, uint32_t inserted) {
 void ShardServer::read_sample_socket(Clock::time_point now) {
   for (int i = 0; i < kDrainBudget && waiting_count_ < kMaxWaitingRequests && sample_.recv_from(identity_, frame_, 0);
        ++i) {
+    learner_->received(frame_.size());
     const wire::Envelope* env = wire::open_envelope(frame_.bytes());
     if (env == nullptr) {
       malformed(log_sample_, "sample", "not a verified envelope of this schema", now);
@@ -557,7 +634,10 @@ void ShardServer::serve_waiting_requests(Clock::time_point now) {
     waiting_head_ = (waiting_head_ + 1) % kMaxWaitingRequests;
     --waiting_count_;
     waiting_now_.store(waiting_count_, std::memory_order_relaxed);
-    if (!sample_.send_to({head.identity.data(), head.identity_size}, wire::bytes_of(fbb_), 0)) {
+    const bool queued = sample_.send_to({head.identity.data(), head.identity_size}, wire::bytes_of(fbb_), 0);
+    if (queued) {
+      learner_->sent(wire::bytes_of(fbb_).size());
+    } else {
       replies_dropped_.fetch_add(1, std::memory_order_relaxed);
       transitions_dropped_.fetch_add(head.batch_size, std::memory_order_relaxed);
       if (log_reply_.open(now)) {

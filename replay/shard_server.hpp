@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "core/peer_stats.hpp"
 #include "core/rng.hpp"
 #include "core/transport.hpp"
 #include "core/wire.hpp"
@@ -161,6 +162,11 @@ struct ShardCounters {
   int64_t map_version = 0;          // of the last ClusterMap; 0 before joining
   int64_t joins = 0;                // ClusterMaps taken (1 + re-joins)
   int64_t restored = 0;             // transitions restored from the snapshot at start
+  // Replay-table transitions gone by the table's own rule: overwritten by the FIFO ring when
+  // full, or dropped with the table when a new map changes its capacity or widths. So at any
+  // time inserted + restored == size + evicted: what was acknowledged is held or counted here.
+  int64_t evicted = 0;
+  int64_t batches_duplicate = 0;    // batches refused as already stored (same writer, sequence not newer)
   int64_t acks_dropped = 0;         // InsertAcks ZeroMQ could not queue (actor gone); later ones cover them
   int64_t connections_refused = 0;  // failed handshakes at the insert and sample sockets (no or wrong CURVE key)
 };
@@ -172,6 +178,8 @@ using ShardConfigFromMap = std::function<ShardConfig(const std::string& config_t
 class ShardServer {
  public:
   static constexpr int kMaxWaitingRequests = 64;
+  // Traffic and liveness per peer: "learner" and "actor:#INDEX" (core/peer_stats.hpp).
+  [[nodiscard]] net::PeerTable& peers() { return peers_; }
 
   // Binds both ROUTERs and connects to the learner. Throws std::runtime_error for a bad
   // endpoint or a port in use. `ctx` must outlive the server.
@@ -258,14 +266,34 @@ class ShardServer {
   Clock::time_point started_{};
   bool inserts_held_ = false;
   Clock::duration blocked_{};
-  LogGate log_insert_, log_sample_, log_join_, log_reply_, log_waiting_, log_silent_;
+  LogGate log_insert_, log_sample_, log_join_, log_reply_, log_waiting_, log_silent_, log_duplicate_;
+  // Deduplication: the newest sequence stored per writer (TransitionBatch.writer). Batches of one
+  // writer reach a shard in sequence order, so one not newer than its mark was stored already
+  // (sent again after a reconnect). Reserved at kMaxWriters; when full, the writer heard from
+  // least recently is forgotten. A linear scan: a shard has tens of writers.
+  struct WriterMark {
+    uint64_t writer = 0;
+    uint64_t sequence = 0;
+    uint64_t last_seen = 0;  // the batch count when last heard, for forgetting the oldest
+  };
+  static constexpr size_t kMaxWriters = 4096;
+  std::vector<WriterMark> writers_;
+  uint64_t batches_seen_ = 0;
+  // True (and counted) if the writer's batch `sequence` was stored already; else notes nothing.
+  bool duplicate(uint64_t writer, uint64_t sequence, Clock::time_point now);
+  void mark_stored(uint64_t writer, uint64_t sequence);
   std::array<int64_t, kHbCount> hb_counters_{};
+
+  net::PeerTable peers_;
+  net::PeerCounters* learner_ = &peers_.peer("learner");  // join socket and sample socket
+  bool learner_silent_ = false;
+  net::PeerCounters& actor_peer(uint32_t actor_id);
 
   std::atomic<bool> stop_{false};
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
       size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0},
-      restored_{0}, demo_inserted_{0}, acks_dropped_{0};
+      restored_{0}, demo_inserted_{0}, acks_dropped_{0}, evicted_{0}, batches_duplicate_{0};
 };
 
 }  // namespace pamdp

@@ -146,6 +146,48 @@ TEST(Metrics, RoleUpdatesAllocateNothing) {
   EXPECT_NE(a.find("pamdp_episode_return_mean_100 2\n"), std::string::npos) << a;
 }
 
+// Per-peer series (core/peer_stats.hpp, app::register_peer_metrics): peers known before the
+// registration and added after it, counting that allocates nothing, silence, and the bound.
+TEST(PeerMetrics, EveryPeerGetsItsSeries) {
+  net::PeerTable table(3);
+  net::PeerCounters& learner = table.peer("learner");  // before the metrics are registered
+  Registry r;
+  app::register_peer_metrics(r, table);
+  net::PeerCounters& shard = table.peer("replay:tcp://10.0.0.2:7001");
+  EXPECT_EQ(&table.peer("learner"), &learner);
+  EXPECT_TRUE(table.knows("replay:tcp://10.0.0.2:7001"));
+  EXPECT_FALSE(table.knows("actor:x"));
+  {
+    testing::alloc::CountAllocations count;
+    for (int i = 0; i < 10; ++i) {
+      learner.received(100);
+      shard.sent(40);
+    }
+    shard.reconnected();
+    EXPECT_EQ(count.count(), 0);
+  }
+  const std::string t = r.render();
+  EXPECT_NE(t.find("pamdp_peer_messages_received_total{peer=\"learner\"} 10\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_peer_bytes_received_total{peer=\"learner\"} 1000\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_peer_bytes_sent_total{peer=\"replay:tcp://10.0.0.2:7001\"} 400\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_peer_reconnects_total{peer=\"replay:tcp://10.0.0.2:7001\"} 1\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_peer_silence_seconds{peer=\"replay:tcp://10.0.0.2:7001\"} -1\n"), std::string::npos)
+      << t;  // never heard from
+  for (const Sample& s : parse_exposition(t)) {
+    if (s.name == "pamdp_peer_silence_seconds" && *s.label("peer") == "learner") {
+      EXPECT_GE(s.value, 0.0);
+      EXPECT_LT(s.value, 5.0);
+    }
+  }
+  // Past the bound, new names share "other".
+  net::PeerCounters& third = table.peer("actor:a");
+  EXPECT_EQ(third.name, "actor:a");
+  net::PeerCounters& other = table.peer("actor:b");
+  EXPECT_EQ(other.name, "other");
+  EXPECT_EQ(&table.peer("actor:c"), &other);
+  EXPECT_NE(r.render().find("pamdp_peer_messages_sent_total{peer=\"other\"} 0\n"), std::string::npos);
+}
+
 TEST(MetricsHttp, ServesAndFetchesOverLoopback) {
   Registry r;
   Counter& c = r.counter("pamdp_scrapes_seen_total", "x");

@@ -476,8 +476,8 @@ class FakeActor {
   FakeActor(net::Context& ctx, const std::string& insert_endpoint) : dealer_(ctx, net::SocketType::kDealer) {
     dealer_.connect(insert_endpoint);
   }
-  void insert(const Rows& rows, uint64_t sequence = 0, uint8_t table = wire::kReplayTable) {
-    wire::build_transition_batch(fbb_, 7, sequence, rows.view(), table);
+  void insert(const Rows& rows, uint64_t sequence = 0, uint8_t table = wire::kReplayTable, uint64_t writer = 0) {
+    wire::build_transition_batch(fbb_, 7, sequence, rows.view(), table, writer);
     ASSERT_TRUE(dealer_.send(wire::bytes_of(fbb_), 1000));
   }
   void send_raw(std::span<const uint8_t> bytes) { ASSERT_TRUE(dealer_.send(bytes, 1000)); }
@@ -814,6 +814,53 @@ TEST(ShardServer, AcknowledgesEveryBatchItReadsAndNoneWhileInsertsAreHeld) {
   EXPECT_EQ(shard.server().counters().acks_dropped, 0);
 }
 
+TEST(ShardServer, ABatchArrivingTwiceIsStoredOnce) {
+  using Ack = std::pair<uint64_t, uint32_t>;
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config()));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  constexpr uint64_t kWriter = 0x1234'5678'9abc'def0;
+  actor.insert(make_rows(3, 0.0F), 5, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 3}}));
+  // Sent again (after a reconnect) and an older one: acknowledged so the window moves, not stored.
+  actor.insert(make_rows(3, 0.0F), 5, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 0}}));
+  actor.insert(make_rows(2, 0.0F), 4, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{4, 0}}));
+  actor.insert(make_rows(2, 0.0F), 7, wire::kReplayTable, kWriter);  // newer (sequences skip other shards')
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{7, 2}}));
+  // Another writer's sequence 5 is its own; writer 0 (an older actor) is never deduplicated.
+  actor.insert(make_rows(1, 0.0F), 5, wire::kReplayTable, kWriter + 1);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
+  actor.insert(make_rows(1, 0.0F), 5);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
+  actor.insert(make_rows(1, 0.0F), 5);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
+  const ShardCounters c = shard.server().counters();
+  EXPECT_EQ(c.batches_duplicate, 2);
+  EXPECT_EQ(c.inserted, 3 + 2 + 1 + 2);
+  EXPECT_EQ(c.size, c.inserted);
+  EXPECT_EQ(c.malformed, 0);
+}
+
+TEST(ShardServer, WhatWasInsertedIsHeldOrCountedAsEvicted) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config(1.0, 1, 1000, 10)));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+  for (uint64_t seq = 1; seq <= 5; ++seq) {
+    actor.insert(make_rows(4, 0.0F), seq, wire::kReplayTable, 99);
+    ASSERT_TRUE(actor.ack().has_value());
+  }
+  const ShardCounters c = shard.server().counters();
+  EXPECT_EQ(c.inserted, 20);
+  EXPECT_EQ(c.size, 10);
+  EXPECT_EQ(c.evicted, 10);  // the ring of 10 overwrote its oldest 10
+}
+
 TEST(ShardServer, WaitingRequestsAreServedInOrder) {
   net::Context ctx;
   FakeLearner learner(ctx);
@@ -1110,7 +1157,8 @@ TEST(ShardServer, NewWidthsFromTheLearnerRebuildTheShard) {
   learner.send_map(2);  // a map with wider states
   ASSERT_TRUE(eventually([&] { return shard.server().counters().joins == 2; }));
   EXPECT_TRUE(eventually([&] { return shard.server().counters().size == 0; }));
-  actor.insert(make_rows(2, 0.0F));  // old widths: malformed now
+  EXPECT_EQ(shard.server().counters().evicted, 3);  // dropped with the old table, and counted
+  actor.insert(make_rows(2, 0.0F));                 // old widths: malformed now
   actor.insert(make_rows(2, 0.0F, kObs + 2));
   ASSERT_TRUE(eventually([&] { return shard.server().counters().size == 2; }));
   EXPECT_EQ(shard.server().counters().malformed, 1);
