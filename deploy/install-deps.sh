@@ -20,6 +20,7 @@ packages=(
   prometheus               # the test that scrapes a running cluster with a real Prometheus
   clang-format             # tests/run.sh checks formatting
   python3-dev python3-pybind11 python3-numpy  # the Python module pamdp (python/) and its tests
+  iproute2 iptables curl   # the network fault test: namespaces, veth, loss and partitions; /metrics scrapes
 )
 
 missing=()
