@@ -11,9 +11,9 @@ bridge's namespace, which adds a one-way delay per direction.
       delay). Every chunk read is released at max(the previous chunk's release, arrival +
       DELAY +- uniform JITTER), so bytes stay in order. A connection holds at most --cap bytes
       per direction (default 4 MB): it stops reading its source until the destination takes
-      them. A FIN is forwarded after the bytes before it, a reset at once. The upstream connect
-      has no timeout of its own (the kernel's SYN retries), and is cancelled when the client
-      goes away first. Logs every connection and every change of the control file on stdout.
+      them. A FIN is forwarded after the bytes before it, a reset at once. An upstream connect
+      that does not complete within --connect-timeout (1 s) closes the client's connection, as
+      a SYN without an answer would time out; it is cancelled when the client goes away first. Logs every connection and every change of the control file on stdout.
   delay_relay.py echo-server [--tcp PORT] [--udp PORT]
       Echoes TCP bytes and UDP datagrams back to their sender (binds 0.0.0.0).
   delay_relay.py tcp-rtt HOST PORT [--count N] [--timeout S]
@@ -144,9 +144,10 @@ def nodelay(writer):
 
 
 class Relay:
-    def __init__(self, control, cap):
+    def __init__(self, control, cap, connect_timeout):
         self.control = control
         self.cap = cap
+        self.connect_timeout = connect_timeout
         self.next_id = 0
         self.open = 0
 
@@ -164,7 +165,14 @@ class Relay:
         upstream_writer = None
         reason = "closed"
         try:
-            connect = asyncio.ensure_future(asyncio.open_connection(target[0], target[1]))
+            # A client on a real network whose SYN gets no answer times out and tries again (pamdp's
+            # sockets after 2 s). Through the relay its connect succeeds at once, so an upstream
+            # that does not answer within --connect-timeout closes the client's connection, which
+            # then tries again, as it would without the relay (the kernel's own SYN retries back
+            # off to tens of seconds and would make a healed link look dead for that long).
+            connect = asyncio.ensure_future(
+                asyncio.wait_for(asyncio.open_connection(target[0], target[1]), self.connect_timeout)
+            )
             read_client = asyncio.ensure_future(up.pump_in(client_reader))
             tasks = [connect, read_client]
             await asyncio.wait([connect, read_client], return_when=asyncio.FIRST_COMPLETED)
@@ -223,7 +231,7 @@ def cmd_relay(args):
         host, tport = target.rsplit(":", 1)
         maps.append((int(port), (host, int(tport))))
     control = Control(args.control)
-    asyncio.run(Relay(control, args.cap).run(args.listen, maps))
+    asyncio.run(Relay(control, args.cap, args.connect_timeout).run(args.listen, maps))
 
 
 def cmd_echo_server(args):
@@ -333,6 +341,7 @@ def main():
     p.add_argument("--control", required=True)
     p.add_argument("--map", action="append", required=True, help="PORT=HOST:PORT")
     p.add_argument("--cap", type=int, default=4 << 20, help="bytes pending per direction per connection")
+    p.add_argument("--connect-timeout", type=float, default=1.0, help="seconds for the upstream connect")
     p = sub.add_parser("echo-server")
     p.add_argument("--tcp", type=int, default=0)
     p.add_argument("--udp", type=int, default=0)
