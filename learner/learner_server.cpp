@@ -184,7 +184,10 @@ void LearnerServer::handle_join_socket() {
         break;
       }
       case wire::Payload::Heartbeat: {
-        bool known = actor_index_.count(id) != 0;
+        // An actor counts as known while it is alive (in peers_): one silent past the peer
+        // timeout was dropped from peers_, and when it is heard again (a healed partition) it
+        // must join again to be counted, listed and sent the map; it keeps its index.
+        bool known = actor_index_.count(id) != 0 && peers_.count(peer_id) != 0;
         if (auto peer = peers_.find(peer_id); peer != peers_.end()) {
           peer->second.last_heard = Clock::now();
         }

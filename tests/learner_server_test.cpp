@@ -395,6 +395,59 @@ TEST(LearnerServer, ListsTheMetricsUrlsOfItsPeersForMonitors) {
   EXPECT_EQ(server.counters().actors_alive, 1);
 }
 
+// An actor silent past the peer timeout (a partition) is dropped from the live peers; when its
+// heartbeats come back, the learner answers with map version 0, so it joins again, is counted
+// alive again and keeps its index.
+TEST(LearnerServer, AnActorBackFromSilenceIsToldToJoinAgain) {
+  net::Context ctx;
+  toy::ReachStopEnv env;
+  DdpgAlgorithm ddpg{kObs, env.action_space(), small(), 1, UpdateDevice::kCpu};
+  LearnerServerConfig c = loopback_config();
+  c.peer_timeout_ms = 300;
+  LearnerServer server(ctx, ddpg, c);
+  std::atomic<int64_t> alive{-1};
+  server.on_tick = [&](const LearnerCounters& counters) { alive.store(counters.actors_alive); };
+  std::thread thread([&] { server.run(); });
+
+  flatbuffers::FlatBufferBuilder fbb;
+  net::Message m;
+  net::Socket actor(ctx, net::SocketType::kDealer);
+  actor.connect(server.join_endpoint());
+  wire::build_join_request(fbb, wire::Role::Actor, "actor", "", "", 1, "");
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  const wire::Envelope* map = await_payload(actor, m, wire::Payload::ClusterMap);
+  ASSERT_NE(map, nullptr);
+  const uint64_t version = map->payload_as_ClusterMap()->version();
+  const uint32_t index = map->payload_as_ClusterMap()->actor_index();
+  const int64_t counters[] = {0};
+  // While it is alive, its heartbeat is answered with the current map version.
+  wire::build_heartbeat(fbb, wire::Role::Actor, "actor", version, counters);
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  const wire::Envelope* hb = await_payload(actor, m, wire::Payload::Heartbeat);
+  ASSERT_NE(hb, nullptr);
+  EXPECT_EQ(hb->payload_as_Heartbeat()->map_version(), version);
+  // Silent for longer than the peer timeout: no longer alive (the learner ticks once a second).
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (alive.load() != 0 && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(alive.load(), 0);
+  wire::build_heartbeat(fbb, wire::Role::Actor, "actor", version, counters);
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  hb = await_payload(actor, m, wire::Payload::Heartbeat);
+  ASSERT_NE(hb, nullptr);
+  EXPECT_EQ(hb->payload_as_Heartbeat()->map_version(), 0U) << "a dropped actor must be told to join again";
+  wire::build_join_request(fbb, wire::Role::Actor, "actor", "", "", 1, "");
+  ASSERT_TRUE(actor.send(wire::bytes_of(fbb), 1000));
+  map = await_payload(actor, m, wire::Payload::ClusterMap);
+  ASSERT_NE(map, nullptr);
+  EXPECT_EQ(map->payload_as_ClusterMap()->actor_index(), index);
+  server.stop();
+  thread.join();
+  EXPECT_EQ(server.counters().actors_alive, 1);
+  EXPECT_EQ(server.counters().actors_joined, 1);
+}
+
 // With CURVE, a peer whose key the cluster did not issue (even one that knows the learner's
 // public key) is refused in the handshake at both of the learner's bound sockets: its JoinRequest
 // is never answered and its SUB never receives weights, while a subscriber with the cluster's key
