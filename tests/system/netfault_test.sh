@@ -22,6 +22,8 @@
 #     healed host works and is counted again: A0 sends transitions and the learner counts 2 actors;
 #     S0 inserts and is sampled and the learner counts 2 shards; after L, both actors receive new
 #     weights and the learner counts 2 shards and 2 actors;
+#   - 4 s after A0 is cut off, `pamdp monitor --once --json` on the learner lists it, and only it,
+#     among the silent peers;
 #   - sampled every second: every actor's pamdp_actor_weights_version and the learner's
 #     pamdp_updates_total never decrease;
 #   - at the end, per shard: inserted + restored == size + evicted (without
@@ -30,7 +32,8 @@
 #     killed actor counts with its last sample).
 # Skips (exit 77) without root, `ip netns`, iptables or its `statistic` match.
 # Usage: tests/system/netfault_test.sh PATH/TO/pamdp SOURCE_DIR
-# Environment: RECOVER_WITHIN (10), RECOVER_CAP (15), PARTITION_S (30). The namespaces, veths,
+# Environment: RECOVER_WITHIN (10), RECOVER_CAP (15), PARTITION_S (30), LEARNER_SETS (extra
+# learner options, e.g. "--set cluster.requests_in_flight_per_shard=32"). The namespaces, veths,
 # bridge and iptables rules live only in the test's namespaces and go with them on exit; the
 # work directory is kept when a check failed.
 set -euo pipefail
@@ -175,7 +178,7 @@ register() {  # NAME HOST URL
 ip netns exec "${ns[L]}" "$bin" learner --config "$src/deploy/configs/reach_stop.toml" --run-dir "$work/run" \
   --set "cluster.learner_bind=tcp://*:$join_port" --set "cluster.weights_bind=tcp://*:$weights_port" \
   --set "cluster.advertise_host=$relay" --set cluster.curve=true --set "cluster.curve_keys_dir=$work/keys" \
-  "${common[@]}" >"$work/logs/learner.log" 2>&1 &
+  "${common[@]}" ${LEARNER_SETS:-} >"$work/logs/learner.log" 2>&1 &
 pid[learner]=$!
 wait_for 30 "the learner did not list its metrics URL" '[[ -s $work/run/metrics_urls.txt ]]'
 register learner L "$(head -n 1 "$work/run/metrics_urls.txt")"
@@ -413,6 +416,7 @@ partition() {
   cut_at=$(now)
   echo "partition of $h at $(since) ($(date +%T)) for ${PARTITION_S} s"
   probe udp_loss "$from" 50
+  [[ $h == A0 ]] && monitor_marks_silent "$cut_at"
   # The counters the "back" conditions compare with, halfway (they stand still while the host is
   # cut off, and reading them takes seconds on a loaded machine).
   hold "$((PARTITION_S / 2))" "$cut_at"
@@ -425,6 +429,20 @@ partition() {
   [[ $partition_probe == 1.0000 ]] || fail "the partition of $h leaks: UDP loss $from <-> L $partition_probe, expected 1"
   echo "  measured UDP loss $from <-> L while $h was cut off: $partition_probe"
   echo "  $h healed at $(since) ($(date +%T))"
+}
+# monitor_marks_silent CUT_AT: 4 s after the cut, `pamdp monitor --once --json` (two scrapes a
+# second apart) on the learner's /metrics must list exactly one silent actor (A0; A1 talks on):
+# a silent peer is marked within 5 s.
+monitor_marks_silent() {
+  sleep "$(awk -v c="$1" -v t="$(now)" 'BEGIN { d = c + 4 - t; printf "%.2f", (d > 0 ? d : 0) }')"
+  local frame silent started
+  started=$(awk -v c="$1" -v t="$(now)" 'BEGIN { printf "%.1f", t - c }')
+  frame=$(inns L "$bin" monitor "${url[learner]}" --once --json 2>/dev/null | tail -n 1 || true)
+  silent=$("$py" -c 'import json, sys
+peers = json.loads(sys.stdin.read()).get("silent_peers", [])
+print(sum(1 for p in peers if p["peer"].startswith("actor:")))' <<<"$frame" 2>/dev/null || echo "?")
+  echo "  pamdp monitor started $started s after the cut (scrapes then and 1 s later): $silent silent actor(s)"
+  [[ $silent == 1 ]] || soft_fail "pamdp monitor did not mark A0 silent within 5 s (silent actors: $silent; frame: ${frame:0:300})"
 }
 # counters: the values the "back" conditions compare with, read while the host is cut off.
 counters() {
