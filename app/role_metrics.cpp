@@ -208,6 +208,8 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
                  "on a new capacity (inserted + restored = size + evicted)");
   Counter* duplicates = &r.counter("pamdp_replay_batches_duplicate_total",
                                    "Batches refused because the same writer's batch was stored already");
+  Counter* stale = &r.counter("pamdp_replay_batches_stale_total",
+                              "Batches refused as older than the deduplication window (their actor counted them lost)");
   r.on_collect([=, &server] {
     const ShardCounters c = server.counters();
     inserted->set(c.inserted);
@@ -227,6 +229,7 @@ void register_shard_metrics(Registry& r, const ShardServer& server) {
     restored->set(static_cast<double>(c.restored));
     evicted->set(c.evicted);
     duplicates->set(c.batches_duplicate);
+    stale->set(c.batches_stale);
   });
   register_rate(r, *inserted, "pamdp_replay_inserts_per_second", "Transitions stored per second");
   register_rate(r, *sampled, "pamdp_replay_samples_per_second", "Transitions sampled per second");

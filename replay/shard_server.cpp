@@ -254,6 +254,7 @@ ShardCounters ShardServer::counters() const {
   c.restored = restored_.load(r);
   c.evicted = evicted_.load(r);
   c.batches_duplicate = batches_duplicate_.load(r);
+  c.batches_stale = batches_stale_.load(r);
   c.connections_refused = handshakes_.refused();
   return c;
 }
@@ -534,20 +535,56 @@ bool ShardServer::duplicate(uint64_t writer, uint64_t sequence, Clock::time_poin
     return false;  // an actor from before TransitionBatch.writer
   }
   for (const WriterMark& m : writers_) {
-    if (m.writer == writer) {
-      if (sequence > m.sequence) {
-        return false;
-      }
-      const int64_t total = batches_duplicate_.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (m.writer != writer) {
+      continue;
+    }
+    if (sequence > m.newest) {
+      return false;
+    }
+    const uint64_t d = m.newest - sequence;
+    if (d >= kWindow) {
+      const int64_t total = batches_stale_.fetch_add(1, std::memory_order_relaxed) + 1;
       if (log_duplicate_.open(now)) {
-        log::warn("replay shard '{}': refused a batch stored already (writer {:016x}, sequence {} <= {}); {} in all",
-                  options_.name, writer, sequence, m.sequence, total);
+        log::warn(
+            "replay shard '{}': refused a batch older than the deduplication window (writer {:016x}, "
+            "sequence {}, newest {}); {} in all",
+            options_.name, writer, sequence, m.newest, total);
       }
       return true;
     }
+    if ((m.stored[d / 64] >> (d % 64) & 1U) == 0) {
+      return false;  // a late first arrival
+    }
+    const int64_t total = batches_duplicate_.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (log_duplicate_.open(now)) {
+      log::warn("replay shard '{}': refused a batch stored already (writer {:016x}, sequence {}); {} in all",
+                options_.name, writer, sequence, total);
+    }
+    return true;
   }
   return false;
 }
+
+namespace {
+// Shifts a window of bits (bit d of word d / 64) up by `by`: bit d moves to d + by, those past the
+// end fall off.
+template <size_t N>
+void shift_window(std::array<uint64_t, N>& w, uint64_t by) {
+  if (by >= 64 * N) {
+    w.fill(0);
+    return;
+  }
+  const size_t words = by / 64;
+  const unsigned bits = by % 64;
+  for (size_t i = N; i-- > 0;) {
+    uint64_t v = i >= words ? w[i - words] << bits : 0;
+    if (bits != 0 && i >= words + 1) {
+      v |= w[i - words - 1] >> (64 - bits);
+    }
+    w[i] = v;
+  }
+}
+}  // namespace
 
 void ShardServer::mark_stored(uint64_t writer, uint64_t sequence) {
   if (writer == 0) {
@@ -557,7 +594,14 @@ void ShardServer::mark_stored(uint64_t writer, uint64_t sequence) {
   WriterMark* oldest = nullptr;
   for (WriterMark& m : writers_) {
     if (m.writer == writer) {
-      m.sequence = sequence;
+      if (sequence > m.newest) {
+        shift_window(m.stored, sequence - m.newest);
+        m.newest = sequence;
+        m.stored[0] |= 1U;
+      } else {
+        const uint64_t d = m.newest - sequence;  // < kWindow: duplicate() let it through
+        m.stored[d / 64] |= uint64_t{1} << (d % 64);
+      }
       m.last_seen = batches_seen_;
       return;
     }
@@ -565,10 +609,12 @@ void ShardServer::mark_stored(uint64_t writer, uint64_t sequence) {
       oldest = &m;
     }
   }
+  WriterMark fresh{writer, sequence, batches_seen_, {}};
+  fresh.stored[0] = 1U;
   if (writers_.size() < kMaxWriters) {
-    writers_.push_back({writer, sequence, batches_seen_});  // within the reserved capacity
+    writers_.push_back(fresh);  // within the reserved capacity
   } else {
-    *oldest = {writer, sequence, batches_seen_};
+    *oldest = fresh;
   }
 }
 

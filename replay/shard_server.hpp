@@ -166,7 +166,8 @@ struct ShardCounters {
   // full, or dropped with the table when a new map changes its capacity or widths. So at any
   // time inserted + restored == size + evicted: what was acknowledged is held or counted here.
   int64_t evicted = 0;
-  int64_t batches_duplicate = 0;    // batches refused as already stored (same writer, sequence not newer)
+  int64_t batches_duplicate = 0;    // batches refused as stored already (same writer and sequence)
+  int64_t batches_stale = 0;        // batches refused as older than the deduplication window
   int64_t acks_dropped = 0;         // InsertAcks ZeroMQ could not queue (actor gone); later ones cover them
   int64_t connections_refused = 0;  // failed handshakes at the insert and sample sockets (no or wrong CURVE key)
 };
@@ -267,19 +268,25 @@ class ShardServer {
   bool inserts_held_ = false;
   Clock::duration blocked_{};
   LogGate log_insert_, log_sample_, log_join_, log_reply_, log_waiting_, log_silent_, log_duplicate_;
-  // Deduplication: the newest sequence stored per writer (TransitionBatch.writer). Batches of one
-  // writer reach a shard in sequence order, so one not newer than its mark was stored already
-  // (sent again after a reconnect). Reserved at kMaxWriters; when full, the writer heard from
-  // least recently is forgotten. A linear scan: a shard has tens of writers.
+  // Deduplication per writer (TransitionBatch.writer), as IPsec's anti-replay window: the newest
+  // sequence stored and which of the kWindow sequences below it were stored. A batch is refused
+  // as a duplicate only if its own sequence was stored. An older one not stored yet is a late
+  // first arrival and is stored: after a partition, a batch held in the old connection's
+  // retransmissions can arrive after newer ones sent on the new connection (the soak saw one 165
+  // sequences late). One older than the window cannot be checked and is refused as stale; its
+  // actor had already counted it lost with its connection. Reserved at kMaxWriters; when full,
+  // the writer heard from least recently is forgotten. A linear scan: a shard has tens of writers.
+  static constexpr uint64_t kWindow = 1024;
   struct WriterMark {
     uint64_t writer = 0;
-    uint64_t sequence = 0;
-    uint64_t last_seen = 0;  // the batch count when last heard, for forgetting the oldest
+    uint64_t newest = 0;
+    uint64_t last_seen = 0;                       // the batch count when last heard, for forgetting the oldest
+    std::array<uint64_t, kWindow / 64> stored{};  // bit d: sequence newest - d was stored
   };
   static constexpr size_t kMaxWriters = 4096;
   std::vector<WriterMark> writers_;
   uint64_t batches_seen_ = 0;
-  // True (and counted) if the writer's batch `sequence` was stored already; else notes nothing.
+  // True (and counted, as a duplicate or as stale) if the writer's batch must not be stored.
   bool duplicate(uint64_t writer, uint64_t sequence, Clock::time_point now);
   void mark_stored(uint64_t writer, uint64_t sequence);
   std::array<int64_t, kHbCount> hb_counters_{};
@@ -293,7 +300,7 @@ class ShardServer {
   bool ran_ = false;
   std::atomic<int64_t> inserted_{0}, sampled_{0}, malformed_{0}, waiting_now_{0}, blocked_ms_{0}, replies_dropped_{0},
       size_{0}, map_version_pub_{0}, joins_{0}, transitions_dropped_{0}, capacity_{0}, inserts_held_pub_{0},
-      restored_{0}, demo_inserted_{0}, acks_dropped_{0}, evicted_{0}, batches_duplicate_{0};
+      restored_{0}, demo_inserted_{0}, acks_dropped_{0}, evicted_{0}, batches_duplicate_{0}, batches_stale_{0};
 };
 
 }  // namespace pamdp

@@ -818,29 +818,42 @@ TEST(ShardServer, ABatchArrivingTwiceIsStoredOnce) {
   using Ack = std::pair<uint64_t, uint32_t>;
   net::Context ctx;
   FakeLearner learner(ctx);
-  RunningShard shard(ctx, test_options(learner), fixed_config(small_config()));
+  RunningShard shard(ctx, test_options(learner), fixed_config(small_config(1.0, 1, 1000, 1000)));
   join(learner, shard);
   FakeActor actor(ctx, shard.server().insert_endpoint());
   constexpr uint64_t kWriter = 0x1234'5678'9abc'def0;
-  actor.insert(make_rows(3, 0.0F), 5, wire::kReplayTable, kWriter);
-  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 3}}));
-  // Sent again (after a reconnect) and an older one: acknowledged so the window moves, not stored.
-  actor.insert(make_rows(3, 0.0F), 5, wire::kReplayTable, kWriter);
-  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 0}}));
-  actor.insert(make_rows(2, 0.0F), 4, wire::kReplayTable, kWriter);
-  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{4, 0}}));
-  actor.insert(make_rows(2, 0.0F), 7, wire::kReplayTable, kWriter);  // newer (sequences skip other shards')
-  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{7, 2}}));
-  // Another writer's sequence 5 is its own; writer 0 (an older actor) is never deduplicated.
-  actor.insert(make_rows(1, 0.0F), 5, wire::kReplayTable, kWriter + 1);
-  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
+  actor.insert(make_rows(3, 0.0F), 500, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{500, 3}}));
+  // Sent again (after a reconnect): acknowledged so the window moves, not stored.
+  actor.insert(make_rows(3, 0.0F), 500, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{500, 0}}));
+  // Newer ones (sequences skip the other shards'), then a late first arrival: stored once.
+  actor.insert(make_rows(2, 0.0F), 502, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{502, 2}}));
+  actor.insert(make_rows(2, 0.0F), 700, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{700, 2}}));
+  actor.insert(make_rows(1, 0.0F), 499, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{499, 1}}));
+  actor.insert(make_rows(1, 0.0F), 499, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{499, 0}}));
+  actor.insert(make_rows(2, 0.0F), 502, wire::kReplayTable, kWriter);  // still remembered below 700
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{502, 0}}));
+  // Far ahead: 502 falls out of the window and cannot be checked any more: refused as stale.
+  actor.insert(make_rows(1, 0.0F), 2000, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{2000, 1}}));
+  actor.insert(make_rows(2, 0.0F), 502, wire::kReplayTable, kWriter);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{502, 0}}));
+  // Another writer's sequence 500 is its own; writer 0 (an older actor) is never deduplicated.
+  actor.insert(make_rows(1, 0.0F), 500, wire::kReplayTable, kWriter + 1);
+  EXPECT_EQ(actor.ack(), (std::optional<Ack>{{500, 1}}));
   actor.insert(make_rows(1, 0.0F), 5);
   EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
   actor.insert(make_rows(1, 0.0F), 5);
   EXPECT_EQ(actor.ack(), (std::optional<Ack>{{5, 1}}));
   const ShardCounters c = shard.server().counters();
-  EXPECT_EQ(c.batches_duplicate, 2);
-  EXPECT_EQ(c.inserted, 3 + 2 + 1 + 2);
+  EXPECT_EQ(c.batches_duplicate, 3);
+  EXPECT_EQ(c.batches_stale, 1);
+  EXPECT_EQ(c.inserted, 3 + 2 + 2 + 1 + 1 + 1 + 1 + 1);
   EXPECT_EQ(c.size, c.inserted);
   EXPECT_EQ(c.malformed, 0);
 }

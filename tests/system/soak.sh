@@ -289,9 +289,11 @@ sampler_pass
     size=$(value "$t" pamdp_replay_size_transitions)
     ev=$(value "$t" pamdp_replay_transitions_evicted_total)
     dup=$(value "$t" pamdp_replay_batches_duplicate_total)
+    stale=$(value "$t" pamdp_replay_batches_stale_total)
     missing=$(awk -v i="${ins:-0}" -v r="${res:-0}" -v s="${size:-0}" -v e="${ev:-0}" 'BEGIN { printf "%d", i + r - s - e }')
-    echo "$s: inserted $ins restored $res size $size evicted $ev duplicates $dup -> unaccounted $missing"
-    lost=$((lost + ${missing#-} + ${dup:-0}))
+    echo "$s: inserted $ins restored $res size $size evicted $ev -> unaccounted $missing;" \
+      "batches refused: ${dup:-0} duplicates (stored once), ${stale:-0} stale"
+    lost=$((lost + ${missing#-}))
     inserted_all=$((inserted_all + ${ins:-0}))
   done
   sent=0
@@ -306,7 +308,7 @@ sampler_pass
   done
   echo "actors: acknowledged $acked <= inserted $inserted_all <= sent $sent"
   ((acked <= inserted_all)) || lost=$((lost + acked - inserted_all))
-  echo "accepted transitions lost or duplicated: $lost"
+  echo "accepted transitions lost: $lost"
   [[ -s $out/violations.txt ]] && { echo "violations:"; cat "$out/violations.txt"; }
   echo "== learning curve (metrics.csv: minutes, updates, episodes, success rate of the last 100)"
   awk -F, 'BEGIN { last = -1 } NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
