@@ -16,6 +16,7 @@ double PeerCounters::silence_seconds(std::chrono::steady_clock::time_point now) 
 
 PeerCounters& PeerTable::peer(std::string_view name) {
   PeerCounters* added = nullptr;
+  std::function<void(PeerCounters&)> on_added;
   {
     const std::lock_guard lock(mutex_);
     for (PeerCounters& p : peers_) {
@@ -32,10 +33,11 @@ PeerCounters& PeerTable::peer(std::string_view name) {
       name = "other";
     }
     added = &peers_.emplace_back(std::string(name));
+    on_added = on_added_;  // read under the lock: watch() may set it from another thread
   }
   // Outside the lock: on_added takes the metrics registry's lock, whose collect hooks read peers.
-  if (on_added_) {
-    on_added_(*added);
+  if (on_added) {
+    on_added(*added);
   }
   return *added;
 }
@@ -44,13 +46,13 @@ void PeerTable::watch(std::function<void(PeerCounters&)> on_added) {
   std::vector<PeerCounters*> known;
   {
     const std::lock_guard lock(mutex_);
-    on_added_ = std::move(on_added);
+    on_added_ = on_added;
     for (PeerCounters& p : peers_) {
       known.push_back(&p);
     }
   }
   for (PeerCounters* p : known) {
-    on_added_(*p);
+    on_added(*p);
   }
 }
 

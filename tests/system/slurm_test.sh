@@ -228,9 +228,15 @@ wait_for 60 'job $job2 is $(state "$job2"), its learner did not answer' \
 first=$(metric "$lurl" pamdp_updates_total)
 ge "$first" "$ck_updates" || fail "the resumed learner is at $first updates, the checkpoint had $ck_updates"
 wait_for 30 "the resumed shards did not both list their metrics URLs" '[[ $(url_of replay | wc -l) == 2 ]]'
-restored=""
-for u in $(url_of replay); do restored+="$(metric "$u" pamdp_replay_restored_transitions) "; done
-[[ $restored =~ ^[1-9][0-9]*\ [1-9][0-9]*\ $ ]] || fail "the resumed shards restored '$restored' transitions (want two counts > 0)"
+# A shard lists its URL when it asks to join and restores its snapshot when the map comes, and a
+# scrape on a loaded machine can time out: read until both counts are in (once was flaky).
+restored_counts() {
+  local u r=""
+  for u in $(url_of replay); do r+="$(metric "$u" pamdp_replay_restored_transitions) "; done
+  echo "$r"
+}
+wait_for 20 "the resumed shards restored '\$(restored_counts)' transitions (want two counts > 0)" \
+  'restored=$(restored_counts); [[ $restored =~ ^[1-9][0-9]*\ [1-9][0-9]*\ $ ]]'
 wait_for 60 'the resumed learner counts $(shards) shards and $(actors) actors, not 2 and 5' '[[ $(shards) == 2 && $(actors) == 5 ]]'
 seen=$(layout "$job2")
 [[ $seen == "$expected_layout" ]] || fail "processes of job $job2 run as '$seen', not '$expected_layout'"
