@@ -592,6 +592,11 @@ void ActorLoop::Impl::read_acks() {
       s.peer->reconnected();  // libzmq connects again by itself
     }
     for (int n = 0; n < kMaxMessagesPerLook && s.dealer.recv(junk, 0); ++n) {
+      if (s.dealer.too_big(junk)) {
+        s.peer->refused_oversized(junk.size());
+        note_malformed("a shard sent a frame over the size limit of an InsertAck");
+        continue;
+      }
       s.peer->received(junk.size());
       const wire::Envelope* env = wire::open_envelope(junk.bytes());
       if (env == nullptr || env->payload_type() != wire::Payload::InsertAck) {
@@ -720,6 +725,11 @@ void ActorLoop::Impl::poll_weights() {
     const int slot = pending == 0 ? 1 : 0;
     if (!sub.recv(weights_msg[static_cast<size_t>(slot)], 0)) {
       break;
+    }
+    if (sub.too_big(weights_msg[static_cast<size_t>(slot)])) {
+      learner_peer->refused_oversized(weights_msg[static_cast<size_t>(slot)].size());
+      note_malformed("PolicyWeights over the actor's size limit for weights");
+      continue;
     }
     learner_peer->received(weights_msg[static_cast<size_t>(slot)].size());
     if (check_weights(weights_msg[static_cast<size_t>(slot)].bytes()) != nullptr) {

@@ -124,6 +124,12 @@ LearnerLink::Received LearnerLink::receive(ClusterInfo& map, uint64_t& learner_m
   if (!impl_->dealer.recv(impl_->msg, 0)) {
     return Received::kNothing;
   }
+  if (impl_->dealer.too_big(impl_->msg)) {
+    if (impl_->peer != nullptr) {
+      impl_->peer->refused_oversized(impl_->msg.size());
+    }
+    return Received::kMalformed;
+  }
   if (impl_->peer != nullptr) {
     impl_->peer->received(impl_->msg.size());
   }

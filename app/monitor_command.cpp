@@ -76,7 +76,7 @@ class UrlSource {
     }
     const auto until = Clock::now() + std::chrono::milliseconds(timeout_ms);
     while (Clock::now() < until && !g_quit.load()) {
-      if (!socket_.recv(msg_, 50)) {
+      if (!socket_.recv(msg_, 50) || socket_.too_big(msg_)) {
         continue;
       }
       const wire::Envelope* env = wire::open_envelope(msg_.bytes());
@@ -385,6 +385,24 @@ View build_view(const std::vector<Target>& ts, std::vector<double>& return_histo
     }
   }
   j["silent_peers"] = silent;
+  // Frames refused for size, by whom and from whom (pamdp_peer_frames_refused_for_size_total).
+  nlohmann::json oversized = nlohmann::json::array();
+  std::string oversized_list;
+  for (const Target& t : ts) {
+    const std::string prefix = "pamdp_peer_frames_refused_for_size_total{peer=\"";
+    for (const auto& [key, value] : t.now) {
+      if (!t.up || key.rfind(prefix, 0) != 0 || value <= 0.0) {
+        continue;
+      }
+      const std::string peer = key.substr(prefix.size(), key.size() - prefix.size() - 2);
+      oversized.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"frames", value}});
+      if (oversized.size() <= 4) {
+        oversized_list.append(oversized_list.empty() ? "" : ", ").append(peer).append(" -> ").append(t.role);
+        oversized_list.append(" ").append(num(value));
+      }
+    }
+  }
+  j["oversized_frames"] = oversized;
 
   auto& L = v.lines;
   L.push_back("pamdp monitor: " + std::to_string(up) + "/" + std::to_string(ts.size()) + " targets up (" + role_list +
@@ -401,8 +419,12 @@ View build_view(const std::vector<Target>& ts, std::vector<double>& return_histo
               " | params at bound " + num(at_bound * 100.0, 1) + " %");
   L.push_back("episodes    " + num(episodes) + " | goal rate (last 100) " + sig(goal_rate) +
               " | mean return (last 100) " + sig(mean_return) + " | bad messages " + num(bad));
-  L.push_back("links       " + (silent.empty() ? std::string("no silent peer")
-                                               : "SILENT " + std::to_string(silent.size()) + ": " + silent_list));
+  std::string links =
+      silent.empty() ? std::string("no silent peer") : "SILENT " + std::to_string(silent.size()) + ": " + silent_list;
+  if (!oversized.empty()) {
+    links.append(" | frames refused for size: ").append(oversized_list);
+  }
+  L.push_back("links       " + links);
   L.push_back("return      " + sparkline(return_history));
   L.push_back("goal rate   " + sparkline(goal_history));
   L.push_back("");

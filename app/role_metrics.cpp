@@ -245,6 +245,7 @@ void register_peer_metrics(Registry& r, net::PeerTable& table) {
     Counter* messages_out;
     Counter* bytes_out;
     Counter* reconnects;
+    Counter* refused_for_size;
     Gauge* silence;
   };
   struct State {
@@ -261,6 +262,8 @@ void register_peer_metrics(Registry& r, net::PeerTable& table) {
              &r.counter("pamdp_peer_bytes_sent_total", "Bytes sent to the peer", l),
              &r.counter("pamdp_peer_reconnects_total",
                         "Connections to the peer lost and made again, or joins from a new connection", l),
+             &r.counter("pamdp_peer_frames_refused_for_size_total",
+                        "Frames from the peer over the receiving socket's size limit, refused unread", l),
              &r.gauge("pamdp_peer_silence_seconds", "Seconds since the peer's last message (-1: none yet)", l)};
     const std::lock_guard lock(state->mutex);
     state->series.push_back(s);
@@ -275,6 +278,7 @@ void register_peer_metrics(Registry& r, net::PeerTable& table) {
       s.messages_out->set(s.peer->messages_out.load(rl));
       s.bytes_out->set(s.peer->bytes_out.load(rl));
       s.reconnects->set(s.peer->reconnects.load(rl));
+      s.refused_for_size->set(s.peer->refused_for_size.load(rl));
       s.silence->set(s.peer->silence_seconds(now));
     }
   });

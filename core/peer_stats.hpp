@@ -1,6 +1,6 @@
 // Traffic and liveness per peer of one process (docs/reliability.md, "A bad network"): messages
-// and bytes in and out, reconnects, and when the peer was last heard from. /metrics exports them
-// with a `peer` label (app/role_metrics.hpp, register_peer_metrics).
+// and bytes in and out, reconnects, frames refused for size, and when the peer was last heard
+// from. /metrics exports them with a `peer` label (app/role_metrics.hpp, register_peer_metrics).
 //
 // The network thread counts (relaxed atomics: no lock, no allocation); the metrics thread reads.
 // PeerTable::peer() adds a peer on first sight, taking a lock and allocating once per peer; a
@@ -26,8 +26,9 @@ struct PeerCounters {
   std::atomic<int64_t> bytes_in{0};
   std::atomic<int64_t> messages_out{0};
   std::atomic<int64_t> bytes_out{0};
-  std::atomic<int64_t> reconnects{0};  // connections lost and made again, or joins from a new connection
-  std::atomic<int64_t> last_in_ns{0};  // steady_clock of the last message from it; 0 = never
+  std::atomic<int64_t> reconnects{0};        // connections lost and made again, or joins from a new connection
+  std::atomic<int64_t> last_in_ns{0};        // steady_clock of the last message from it; 0 = never
+  std::atomic<int64_t> refused_for_size{0};  // frames over the receiving socket's limit, not read
 
   void received(size_t bytes) {
     messages_in.fetch_add(1, std::memory_order_relaxed);
@@ -39,6 +40,11 @@ struct PeerCounters {
     bytes_out.fetch_add(static_cast<int64_t>(bytes), std::memory_order_relaxed);
   }
   void reconnected() { reconnects.fetch_add(1, std::memory_order_relaxed); }
+  // A frame over the receiving socket's limit (net::Socket::too_big): received, then refused unread.
+  void refused_oversized(size_t bytes) {
+    received(bytes);
+    refused_for_size.fetch_add(1, std::memory_order_relaxed);
+  }
   // Seconds since the last message; -1 if none yet.
   [[nodiscard]] double silence_seconds(std::chrono::steady_clock::time_point now) const;
 };

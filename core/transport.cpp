@@ -129,7 +129,7 @@ Socket::~Socket() {
   }
 }
 
-Socket::Socket(Socket&& o) noexcept : sock_(o.sock_) {
+Socket::Socket(Socket&& o) noexcept : sock_(o.sock_), max_frame_bytes_(o.max_frame_bytes_) {
   o.sock_ = nullptr;
 }
 
@@ -139,6 +139,7 @@ Socket& Socket::operator=(Socket&& o) noexcept {
       zmq_close(sock_);
     }
     sock_ = o.sock_;
+    max_frame_bytes_ = o.max_frame_bytes_;
     o.sock_ = nullptr;
   }
   return *this;
@@ -172,7 +173,9 @@ void Socket::set_router_mandatory(bool on) {
   setint(raw(), ZMQ_ROUTER_MANDATORY, on ? 1 : 0, "router mandatory");
 }
 void Socket::set_max_message_bytes(int64_t bytes) {
-  setopt(raw(), ZMQ_MAXMSGSIZE, &bytes, sizeof(bytes), "max message size");
+  const int64_t cap = bytes < 0 ? -1 : bytes * kFrameCapFactor;
+  setopt(raw(), ZMQ_MAXMSGSIZE, &cap, sizeof(cap), "max message size");
+  max_frame_bytes_ = bytes < 0 ? -1 : bytes;
 }
 void Socket::subscribe_all() {
   setopt(raw(), ZMQ_SUBSCRIBE, "", 0, "subscription");

@@ -71,6 +71,8 @@ struct CurveClientKeys {
 inline constexpr int kHeartbeatIntervalMs = 1000;
 inline constexpr int kHeartbeatTimeoutMs = 10000;
 inline constexpr int kConnectTimeoutMs = 2000;
+// ZeroMQ's own limit on a frame, as a multiple of the caller's (Socket::set_max_message_bytes).
+inline constexpr int64_t kFrameCapFactor = 2;
 
 class Socket {
  public:
@@ -91,9 +93,17 @@ class Socket {
   void set_kernel_buffers(int send_bytes, int recv_bytes);
   // ROUTER: report unroutable messages as errors instead of dropping them silently.
   void set_router_mandatory(bool on);
-  // Largest message accepted; bigger ones make ZeroMQ drop the peer's connection (a cheap first
-  // line of defence against oversized messages). -1 = no limit.
+  // The largest frame the caller accepts. A receive site refuses a bigger one with too_big() and
+  // counts it against the peer it came from (PeerCounters::refused_for_size). ZeroMQ itself drops
+  // the connection only for a frame over kFrameCapFactor times this (ZMQ_MAXMSGSIZE, which libzmq
+  // 4.3 reports as a bare disconnect, from no peer in particular), so a frame a little too big is
+  // seen, refused and counted, and a huge one never reaches memory. -1 = no limit.
   void set_max_message_bytes(int64_t bytes);
+  // Whether a received frame is over set_max_message_bytes.
+  [[nodiscard]] bool too_big(const Message& m) const {
+    return max_frame_bytes_ >= 0 && static_cast<int64_t>(m.size()) > max_frame_bytes_;
+  }
+  [[nodiscard]] int64_t max_message_bytes() const { return max_frame_bytes_; }
   void subscribe_all();  // SUB only
   void make_curve_server(const CurveServerKeys& keys);
   void make_curve_client(const CurveClientKeys& keys);
@@ -120,6 +130,7 @@ class Socket {
 
  private:
   void* sock_ = nullptr;  // the ZeroMQ socket handle
+  int64_t max_frame_bytes_ = -1;
 };
 
 // The address peers use for a bound endpoint: a wildcard host (tcp://*:P, tcp://0.0.0.0:P,

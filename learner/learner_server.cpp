@@ -101,6 +101,15 @@ void LearnerServer::handle_join_socket() {
   net::Message identity;
   net::Message payload;
   while (join_.recv_from(identity, payload, 0)) {
+    if (join_.too_big(payload)) {
+      const auto p = peers_.find(std::string(reinterpret_cast<const char*>(identity.data()), identity.size()));
+      net::PeerCounters& from =
+          p != peers_.end() && p->second.traffic != nullptr ? *p->second.traffic : peers_table_.peer("unknown");
+      from.refused_oversized(payload.size());
+      note_malformed(
+          "join socket: a frame over its size limit, refused unread (pamdp_peer_frames_refused_for_size_total)");
+      continue;
+    }
     const wire::Envelope* env = wire::open_envelope(payload.bytes());
     if (env == nullptr) {
       note_malformed("join socket: not a verified envelope");
@@ -304,6 +313,13 @@ const Sample* LearnerServer::take_reply(Shard& shard) {
   }
   shard.in_flight = std::max(0, shard.in_flight - 1);
   shard.last_heard = Clock::now();
+  if (shard.dealer.too_big(msg)) {
+    if (shard.traffic != nullptr) {
+      shard.traffic->refused_oversized(msg.size());
+    }
+    note_malformed("a shard's reply over its size limit, refused unread (pamdp_peer_frames_refused_for_size_total)");
+    return nullptr;
+  }
   if (shard.traffic != nullptr) {
     shard.traffic->received(msg.size());
   }

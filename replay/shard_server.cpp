@@ -379,8 +379,13 @@ void ShardServer::send_heartbeat(Clock::time_point now) {
 
 void ShardServer::read_join_socket(Clock::time_point now) {
   for (int i = 0; i < kDrainBudget && join_.recv(frame_, 0); ++i) {
-    learner_->received(frame_.size());
     learner_silent_ = false;
+    if (join_.too_big(frame_)) {
+      learner_->refused_oversized(frame_.size());
+      oversized(log_join_, "join", learner_->name, frame_.size(), join_.max_message_bytes(), now);
+      continue;
+    }
+    learner_->received(frame_.size());
     const wire::Envelope* env = wire::open_envelope(frame_.bytes());
     if (env == nullptr) {
       malformed(log_join_, "join", "not a verified envelope of this schema", now);
@@ -471,6 +476,20 @@ void ShardServer::read_insert_socket(Clock::time_point now) {
   const auto obs = static_cast<uint32_t>(shard_->config().obs_dim);
   const auto act = static_cast<uint32_t>(shard_->config().action_dim);
   for (int i = 0; i < kDrainBudget && shard_->can_insert(1) && insert_.recv_from(identity_, frame_, 0); ++i) {
+    if (insert_.too_big(frame_)) {
+      // Counted against its actor when it opens as a batch, and acknowledged with nothing stored
+      // so that the actor's window moves on.
+      const wire::Envelope* env = wire::open_envelope(frame_.bytes());
+      const wire::TransitionBatch* batch = env != nullptr ? env->payload_as_TransitionBatch() : nullptr;
+      net::PeerCounters& from = batch != nullptr ? actor_peer(batch->actor_id()) : peers_.peer("actor:?");
+      from.refused_oversized(frame_.size());
+      oversized(log_insert_, "insert", from.name, frame_.size(), insert_.max_message_bytes(), now);
+      if (batch != nullptr) {
+        acknowledge(batch->sequence(), 0);
+        from.sent(ack_fbb_.GetSize());
+      }
+      continue;
+    }
     const wire::Envelope* env = wire::open_envelope(frame_.bytes());
     if (env == nullptr) {
       malformed(log_insert_, "insert", "not a verified envelope of this schema", now);
@@ -629,6 +648,11 @@ void ShardServer::acknowledge(uint64_t sequence, uint32_t inserted) {
 void ShardServer::read_sample_socket(Clock::time_point now) {
   for (int i = 0; i < kDrainBudget && waiting_count_ < kMaxWaitingRequests && sample_.recv_from(identity_, frame_, 0);
        ++i) {
+    if (sample_.too_big(frame_)) {
+      learner_->refused_oversized(frame_.size());
+      oversized(log_sample_, "sample", learner_->name, frame_.size(), sample_.max_message_bytes(), now);
+      continue;
+    }
     learner_->received(frame_.size());
     const wire::Envelope* env = wire::open_envelope(frame_.bytes());
     if (env == nullptr) {
@@ -701,6 +725,19 @@ void ShardServer::malformed(LogGate& gate, const char* socket, const char* why, 
         "replay shard '{}': dropped a malformed message on the {} socket ({}); {} malformed in all, {} more "
         "on this socket since the last line",
         options_.name, socket, why, total, gate.suppressed);
+    gate.suppressed = 0;
+  }
+}
+
+void ShardServer::oversized(LogGate& gate, const char* socket, const std::string& peer, size_t bytes, int64_t limit,
+                            Clock::time_point now) {
+  const int64_t total = malformed_.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (gate.open(now)) {
+    log::warn(
+        "replay shard '{}': refused a frame of {} bytes from {} on the {} socket, over its limit of {} bytes (a "
+        "peer of another build or configuration, or not one of ours; the insert limit is the shard option "
+        "max_insert_message_bytes); {} malformed in all, {} more on this socket since the last line",
+        options_.name, bytes, peer, socket, limit, total, gate.suppressed);
     gate.suppressed = 0;
   }
 }

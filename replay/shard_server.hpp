@@ -232,6 +232,9 @@ class ShardServer {
   void read_sample_socket(Clock::time_point now);
   void serve_waiting_requests(Clock::time_point now);
   void malformed(LogGate& gate, const char* socket, const char* why, Clock::time_point now);
+  // A frame over its socket's limit (net::Socket::too_big): counted as malformed, and per peer.
+  void oversized(LogGate& gate, const char* socket, const std::string& peer, size_t bytes, int64_t limit,
+                 Clock::time_point now);
   void publish_counters();
 
   ShardServerOptions options_;

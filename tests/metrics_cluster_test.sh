@@ -6,7 +6,8 @@
 #               the test asks Prometheus' HTTP API that every target is up and that counters grew.
 #               Exits 77 (ctest: skipped) with a message when prometheus is not installed.
 #   monitor:    `pamdp monitor --join ... --once --json` and `pamdp monitor URL... --once` against
-#               the cluster, checking the fields they report.
+#               the cluster, checking the fields they report, and that a frame over the
+#               learner's size limit (tests/zmtp_send.py) shows, counted against its peer.
 # Usage: tests/metrics_cluster_test.sh PATH/TO/pamdp SOURCE_DIR prometheus|monitor
 set -euo pipefail
 bin=${1:?path to pamdp}
@@ -91,6 +92,21 @@ if [[ $mode == monitor ]]; then
   echo "$text"
   grep -q "4/4 targets up" <<<"$text" || fail "monitor URL... does not show 4 targets up"
   if grep -q $'\x1b' <<<"$text"; then fail "monitor --once printed escape codes"; fi
+  grep -q '"oversized_frames":\[\]' <<<"$json" || fail "monitor counts oversized frames before any was sent"
+
+  # A frame over the learner's join-socket limit (1 MiB; ZeroMQ's own cap is twice that), from a
+  # connection that never joined: refused, counted against "unknown", shown by the monitor.
+  hostport=${join#tcp://}
+  /usr/bin/python3 "$src/tests/zmtp_send.py" "${hostport%:*}" "${hostport##*:}" $((3 << 19)) ||
+    fail "could not send the oversized frame"
+  for _ in $(seq 20); do
+    json=$("$bin" monitor --join "$join" --once --json | tail -n 1)
+    grep -q '"oversized_frames":\[{"frames":1[.0]*,"observer":"learner:[^"]*","peer":"unknown"}\]' <<<"$json" && break
+    sleep 0.5
+  done
+  grep -q '"peer":"unknown"' <<<"$json" || fail "monitor --json does not list the oversized frame: ${json:0:800}"
+  text=$("$bin" monitor --once --interval 0.5 "${urls[@]}")
+  grep -q "frames refused for size: unknown -> learner 1" <<<"$text" || fail "monitor does not show the oversized frame"
   echo "metrics_cluster_test monitor: OK"
   exit 0
 fi

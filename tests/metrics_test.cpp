@@ -164,6 +164,7 @@ TEST(PeerMetrics, EveryPeerGetsItsSeries) {
       shard.sent(40);
     }
     shard.reconnected();
+    shard.refused_oversized(3000);
     EXPECT_EQ(count.count(), 0);
   }
   const std::string t = r.render();
@@ -171,8 +172,12 @@ TEST(PeerMetrics, EveryPeerGetsItsSeries) {
   EXPECT_NE(t.find("pamdp_peer_bytes_received_total{peer=\"learner\"} 1000\n"), std::string::npos) << t;
   EXPECT_NE(t.find("pamdp_peer_bytes_sent_total{peer=\"replay:tcp://10.0.0.2:7001\"} 400\n"), std::string::npos) << t;
   EXPECT_NE(t.find("pamdp_peer_reconnects_total{peer=\"replay:tcp://10.0.0.2:7001\"} 1\n"), std::string::npos) << t;
-  EXPECT_NE(t.find("pamdp_peer_silence_seconds{peer=\"replay:tcp://10.0.0.2:7001\"} -1\n"), std::string::npos)
-      << t;  // never heard from
+  EXPECT_NE(t.find("pamdp_peer_frames_refused_for_size_total{peer=\"replay:tcp://10.0.0.2:7001\"} 1\n"),
+            std::string::npos)
+      << t;
+  EXPECT_NE(t.find("pamdp_peer_frames_refused_for_size_total{peer=\"learner\"} 0\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("pamdp_peer_bytes_received_total{peer=\"replay:tcp://10.0.0.2:7001\"} 3000\n"), std::string::npos)
+      << t;  // a refused frame was still received
   for (const Sample& s : parse_exposition(t)) {
     if (s.name == "pamdp_peer_silence_seconds" && *s.label("peer") == "learner") {
       EXPECT_GE(s.value, 0.0);

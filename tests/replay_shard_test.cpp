@@ -1080,7 +1080,8 @@ TEST(ShardServer, OversizedFramesNeverReachTheShard) {
   RunningShard shard(ctx, o, fixed_config(small_config()));
   join(learner, shard);
   {
-    // Above max_insert_message_bytes: ZeroMQ drops this connection before the shard sees it.
+    // Far above max_insert_message_bytes (past net::kFrameCapFactor times it): ZeroMQ drops this
+    // connection before the shard sees it.
     FakeActor big(ctx, shard.server().insert_endpoint());
     const std::vector<uint8_t> huge(size_t{1} << 20, 0xAB);
     big.send_raw(huge);
@@ -1092,6 +1093,43 @@ TEST(ShardServer, OversizedFramesNeverReachTheShard) {
   sampler.request(1, 4);
   ASSERT_NE(sampler.reply(), nullptr);
   EXPECT_EQ(shard.server().counters().malformed, 0);
+}
+
+// Between the limit and ZeroMQ's own cap (net::kFrameCapFactor times it) a frame is delivered,
+// refused unread and counted against the peer that sent it; the connection stays.
+TEST(ShardServer, AFrameOverTheLimitIsRefusedAndCountedAgainstItsActor) {
+  net::Context ctx;
+  FakeLearner learner(ctx);
+  flatbuffers::FlatBufferBuilder fbb;
+  wire::build_transition_batch(fbb, 7, 5, make_rows(64, 1.0F).view(), wire::kReplayTable, 42);
+  const std::vector<uint8_t> big(wire::bytes_of(fbb).begin(), wire::bytes_of(fbb).end());
+  ShardServerOptions o = test_options(learner);
+  o.max_insert_message_bytes = static_cast<int64_t>(big.size()) * 3 / 4;
+  ASSERT_LT(static_cast<int64_t>(big.size()), o.max_insert_message_bytes * net::kFrameCapFactor);
+  RunningShard shard(ctx, o, fixed_config(small_config()));
+  join(learner, shard);
+  FakeActor actor(ctx, shard.server().insert_endpoint());
+
+  // A batch over the limit: acknowledged with nothing stored, so the actor's window moves on.
+  actor.send_raw(big);
+  const auto refused = actor.ack();
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_EQ(*refused, (std::pair<uint64_t, uint32_t>{5, 0}));
+  // Junk over the limit opens as no batch: counted against no actor in particular.
+  actor.send_raw(std::vector<uint8_t>(big.size(), 0xAB));
+  // The same connection goes on.
+  actor.insert(make_rows(2, 30.0F), 6, wire::kReplayTable, 42);
+  const auto stored = actor.ack();
+  ASSERT_TRUE(stored.has_value());
+  EXPECT_EQ(*stored, (std::pair<uint64_t, uint32_t>{6, 2}));
+  EXPECT_EQ(shard.server().counters().inserted, 2);
+  EXPECT_EQ(shard.server().counters().malformed, 2);
+  ASSERT_TRUE(shard.server().peers().knows("actor:#7"));
+  ASSERT_TRUE(shard.server().peers().knows("actor:?"));
+  const net::PeerCounters& seven = shard.server().peers().peer("actor:#7");
+  EXPECT_EQ(seven.refused_for_size.load(), 1);
+  EXPECT_EQ(seven.messages_in.load(), 2);
+  EXPECT_EQ(shard.server().peers().peer("actor:?").refused_for_size.load(), 1);
 }
 
 TEST(ShardServer, HeartbeatsCarryCountersAndANewerMapMeansJoiningAgain) {

@@ -2,8 +2,9 @@
 # The cluster on a bad network for hours (issue 82; not in CI). A learner, 2 replay shards and 2
 # actors train HFO 1v0 (deploy/configs/hfo-mpdqn.toml by default), each process in a network
 # namespace of its own, every connection through tests/system/delay_relay.py (the topology of
-# tests/system/netfault_test.sh), CURVE on. Every --fault-every seconds one fault, drawn at
-# random (seeded), is injected and measured with a probe:
+# tests/system/netfault_test.sh), CURVE on. Every --fault-every seconds one fault, dealt
+# from a deck shuffled with the seed (each kind once in every six), is injected and measured
+# with a probe:
 #   delay      100 +- 20 ms one way on every link, for 60 s;
 #   loss       5 % of packets dropped at every host's INPUT, for 60 s;
 #   partition  an actor, a shard or the learner cut off (iptables DROP in and out) for 30 s;
@@ -205,8 +206,24 @@ faults=$out/faults.txt
 : >"$faults"
 note_fault() { echo "$(elapsed) $*" >>"$faults"; say "fault: $*"; }
 replacement=0
+# The six kinds (delay, loss, partition of an actor, of a shard, of the learner, vanish) are dealt
+# from a deck shuffled with the seed, so every kind comes once in every six faults.
+deck=()
+next_kind() {
+  if ((${#deck[@]} == 0)); then
+    deck=(0 1 2 3 4 5)
+    local i j t
+    for ((i = 5; i > 0; i--)); do
+      j=$((RANDOM % (i + 1))) t=${deck[i]}
+      deck[i]=${deck[j]} deck[j]=$t
+    done
+  fi
+  kind=${deck[0]}
+  deck=("${deck[@]:1}")
+}
 inject() {
-  local kind=$((RANDOM % 6)) h
+  local kind h
+  next_kind
   case $kind in
     0)
       echo "100 20" >"$control"
