@@ -382,6 +382,7 @@ void ActorLoop::Impl::run(const std::atomic<bool>& stop_flag,
 
 void ActorLoop::Impl::reset(EnvSlot& slot) {
   const ExplorationConfig& x = config.exploration;
+  slot.env->set_training_updates(updates);
   slot.player.begin(mix_seeds(slot.seed, slot.episodes),
                     demo_share(updates, x.demo_fraction, x.demo_anneal_updates, x.demo_fraction_end), explore.rng());
 }

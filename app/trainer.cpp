@@ -224,6 +224,7 @@ TrainSummary Trainer::run() {
   while (!should_stop()) {
     // One episode. The demonstration draw is skipped when demonstrations are off, so runs
     // without them keep their streams.
+    env_->set_training_updates(algorithm_->updates());
     player_.begin(mix_seeds(c_.seed, 100000 + static_cast<uint64_t>(run_.episodes())),
                   demo_share(algorithm_->updates(), exploration_.demo_fraction, exploration_.demo_anneal_updates,
                              exploration_.demo_fraction_end),

@@ -64,6 +64,12 @@ class Env {
   virtual void reset(std::span<float> obs) = 0;
   virtual StepResult step(const ParamAction& action, std::span<float> obs) = 0;
 
+  // The learner's update count, told before every reset by the episode path of `pamdp train` and
+  // of every actor (app/trainer.cpp, actor/actor_loop.cpp). An env with a curriculum over
+  // training (hfo: env.start_curriculum_updates) draws its next starts from it; one never told,
+  // such as an evaluation's, plays its full task. The default ignores it.
+  virtual void set_training_updates(int64_t updates) { (void)updates; }
+
   // Learned players it steps at once; 1 but for a team game.
   [[nodiscard]] virtual int agents() const { return 1; }
   // One step of every player: actions[i] is player i's; writes each player's next observation

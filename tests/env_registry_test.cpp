@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "envs/hfo/hfo_env.hpp"
 #include "envs/registry.hpp"
 #include "envs/toy/reach_stop.hpp"
 
@@ -93,6 +94,29 @@ TEST(EnvRegistry, SizesFollowTheSettings) {
   EXPECT_EQ(env_registry().find("hfo-server").observation_size(p), 68);  // native encoding, no server needed
   p.set("server_encoding", std::string("embedded"));
   EXPECT_EQ(env_registry().find("hfo-server").observation_size(p), 66);
+}
+
+// env.start_curriculum_* reach the embedded simulator, and only through set_training_updates:
+// an env never told (an evaluation's) plays the full starts.
+TEST(EnvRegistry, TheHfoStartCurriculumActsOnlyWhenTold) {
+  EnvParams p = env_registry().defaults();
+  EXPECT_EQ(p.integer("start_curriculum_updates"), 0);
+  EXPECT_EQ(p.integer("start_curriculum_percent"), 25);
+  EXPECT_FALSE(env_registry().reads("hfo-server", "start_curriculum_updates"));
+  p.set("start_curriculum_updates", int64_t{100});
+  p.set("start_curriculum_percent", int64_t{40});
+  const auto told = env_registry().find("hfo").make(p);
+  const auto untold = env_registry().find("hfo").make(p);
+  const auto& sim = [](const Env& e) -> const hfo::SoccerSim& { return dynamic_cast<const hfo::HfoEnv&>(e).sim(); };
+  told->set_training_updates(50);
+  EXPECT_DOUBLE_EQ(sim(*told).start_scale(), 0.7);
+  EXPECT_DOUBLE_EQ(sim(*untold).start_scale(), 1.0);
+  std::vector<float> obs(static_cast<size_t>(told->observation_size()));
+  told->reset(5, obs);
+  untold->reset(5, obs);
+  const hfo::Vec2 near = sim(*told).state().ball.pos;
+  const hfo::Vec2 far = sim(*untold).state().ball.pos;
+  EXPECT_NEAR(52.5 - near.x, 0.7 * (52.5 - far.x), 1e-9);
 }
 
 TEST(EnvRegistry, ADuplicateRegistrationIsRefused) {

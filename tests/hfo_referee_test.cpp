@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
 #include <span>
+#include <utility>
 
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/geometry.hpp"
@@ -402,6 +404,49 @@ TEST(HfoStart, PaperDistributionRanges) {
   EXPECT_LT(by_min, -27.2 + 0.5);
   EXPECT_GT(by_max, 27.2 - 0.5);
   EXPECT_GT(agent_at_left, 0);
+}
+
+// The start curriculum (issue 80): with the same draws, ball and players start at
+// start_curriculum_from of their distance to the goal's centre at update 0, the fraction rising
+// linearly to 1 at start_curriculum_updates; never told the updates, or past the end, the start is
+// the distribution's own, bit for bit.
+TEST(HfoStart, TheCurriculumMovesStartsTowardTheGoalAndEndsOnTheDistribution) {
+  SoccerSimConfig plain;
+  plain.start = StartDistribution::kPaper;
+  SoccerSimConfig taught = plain;
+  taught.start_curriculum_updates = 1000;
+  taught.start_curriculum_from = 0.25;
+  const Vec2 goal{52.5, 0.0};
+  for (const auto& [updates, scale] :
+       std::initializer_list<std::pair<int64_t, double>>{{-1, 1.0}, {0, 0.25}, {400, 0.55}, {1000, 1.0}, {5000, 1.0}}) {
+    SoccerSim reference(plain, 31);
+    SoccerSim sim(taught, 31);
+    if (updates >= 0) {
+      sim.set_training_updates(updates);
+    }
+    EXPECT_DOUBLE_EQ(sim.start_scale(), scale) << updates;
+    for (int episode = 0; episode < 50; ++episode) {
+      reference.reset_episode();
+      sim.reset_episode();
+      const Vec2 b = reference.state().ball.pos;
+      const Vec2 a = reference.state().players[0].pos;
+      if (scale == 1.0) {
+        ASSERT_EQ(sim.state().ball.pos.x, b.x);
+        ASSERT_EQ(sim.state().ball.pos.y, b.y);
+        ASSERT_EQ(sim.state().players[0].pos.x, a.x);
+        ASSERT_EQ(sim.state().players[0].pos.y, a.y);
+        continue;
+      }
+      ASSERT_NEAR(sim.state().ball.pos.x, goal.x + scale * (b.x - goal.x), 1e-12) << updates;
+      ASSERT_NEAR(sim.state().ball.pos.y, scale * b.y, 1e-12);
+      ASSERT_NEAR(sim.state().players[0].pos.x, goal.x + scale * (a.x - goal.x), 1e-12);
+      ASSERT_NEAR(sim.state().players[0].pos.y, scale * a.y, 1e-12);
+      if (scale == 0.25) {
+        // The paper's ball, up to 54.5 m from the goal's centre (x 5.23, |y| 27.2), starts within 13.7 m.
+        ASSERT_LE((sim.state().ball.pos - goal).r(), 13.7);
+      }
+    }
+  }
 }
 
 // kDec2015: ball x = 52.5 * U[0, 0.2] in [0, 10.5]; agent x clamped to [-0.1, 21], |y| <= 27.2.

@@ -88,6 +88,7 @@ class HfoEnv final : public Env {
 
   void reset(uint64_t seed, std::span<float> obs) override;
   void reset(std::span<float> obs) override;
+  void set_training_updates(int64_t updates) override { sim_.set_training_updates(updates); }
   StepResult step(const ParamAction& action, std::span<float> obs) override;
 
   // Starts an episode from an explicit state (tests, `pamdp sim trace`).

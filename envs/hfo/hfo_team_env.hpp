@@ -40,6 +40,7 @@ class HfoTeamEnv final : public Env {
 
   void reset(uint64_t seed, std::span<float> obs) override;
   void reset(std::span<float> obs) override;
+  void set_training_updates(int64_t updates) override { sim_.set_training_updates(updates); }
   // Starts an episode from an explicit state (tests, `pamdp sim trace`): one state per offense
   // player; `goalie` (may be null) replaces the goalie's start on an env with a goalie.
   void set_state(std::span<const PlayerState> offense, const BallState& ball, const PlayerState* goalie,

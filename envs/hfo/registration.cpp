@@ -131,8 +131,15 @@ void register_hfo_env(EnvRegistry& registry) {
   r.keys.push_back(EnvKey::integer("out_of_bounds_penalty", 0, 0, 100));
   // With env.offense_agents > 1: every player earns the team's mean shaped reward, not its own.
   r.keys.push_back(EnvKey::boolean("team_reward", false));
+  // The start curriculum (hfo::SoccerSimConfig::start_curriculum_*): over this many learner
+  // updates the starts move out from start_curriculum_percent of their distance to the goal to
+  // the whole of it. 0 = off. Training only: evaluations play the full starts.
+  r.keys.push_back(EnvKey::integer("start_curriculum_updates", 0, 0, int64_t{1} << 40));
+  r.keys.push_back(EnvKey::integer("start_curriculum_percent", 25, 1, 100));
   r.make = [](const EnvParams& p) -> std::unique_ptr<Env> {
-    const hfo::SoccerSimConfig c = hfo::sim_config(p);
+    hfo::SoccerSimConfig c = hfo::sim_config(p);
+    c.start_curriculum_updates = p.integer("start_curriculum_updates");
+    c.start_curriculum_from = static_cast<double>(p.integer("start_curriculum_percent")) / 100.0;
     const int penalty = static_cast<int>(p.integer("out_of_bounds_penalty"));
     if (c.offense_agents > 1) {
       return std::make_unique<hfo::HfoTeamEnv>(c, p.boolean("shoot_action"), penalty, p.boolean("team_reward"));

@@ -78,6 +78,15 @@ SoccerSim::SoccerSim(const SoccerSimConfig& config, uint64_t seed) : config_(con
   set_state(std::span<const PlayerState>(offense.data(), config_.offense_agents), BallState{{10.0, 0.0}, {0.0, 0.0}});
 }
 
+void SoccerSim::set_training_updates(int64_t updates) {
+  const int64_t span = config_.start_curriculum_updates;
+  if (span <= 0) {
+    return;
+  }
+  const double done = std::clamp(static_cast<double>(updates) / static_cast<double>(span), 0.0, 1.0);
+  start_scale_ = config_.start_curriculum_from + (1.0 - config_.start_curriculum_from) * done;
+}
+
 void SoccerSim::reset_episode() {
   // Ball (velocity 0), reference §5.1.
   double bx = 0.0;
@@ -86,7 +95,7 @@ void SoccerSim::reset_episode() {
     case StartDistribution::kDec2015:
     case StartDistribution::kHfo: bx = kPitchHalfLength * rng_.uniform(0.0, 0.2); break;
   }
-  const double by = kPitchHalfWidth * rng_.uniform(-0.8, 0.8);
+  double by = kPitchHalfWidth * rng_.uniform(-0.8, 0.8);
 
   // Offense agents: HFORef::resetField (rcssserver referee.cpp) shuffles its ten offsets
   // around the ball each reset and gives offset i to the i-th offense player, so no two share
@@ -123,6 +132,18 @@ void SoccerSim::reset_episode() {
         break;
     }
     offense[i].pos = {ax, ay};
+  }
+  if (start_scale_ < 1.0) {
+    // The start curriculum: ball and players drawn as above, moved toward the goal's centre.
+    const auto toward_goal = [s = start_scale_](Vec2 p) {
+      return Vec2{kPitchHalfLength + s * (p.x - kPitchHalfLength), s * p.y};
+    };
+    const Vec2 b = toward_goal({bx, by});
+    bx = b.x;
+    by = b.y;
+    for (int i = 0; i < n; ++i) {
+      offense[i].pos = toward_goal(offense[i].pos);
+    }
   }
   for (int i = 0; i < n; ++i) {
     double body = state_.players[i].body_deg;

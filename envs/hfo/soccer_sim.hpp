@@ -67,6 +67,12 @@ struct SoccerSimConfig {
   bool goalie = false;        // an NPC goalie defends the goal (1v1): players()[1], 66 features
   // Learned offense players, HFO's --offense-agents (1-4): players()[0 .. offense_agents - 1].
   int offense_agents = 1;
+  // A curriculum over training (not HFO's; issue 80): a start drawn from `start` has the ball and
+  // the players moved toward the goal's centre, to start_curriculum_from of their distance at
+  // update 0, rising linearly to the whole distance at start_curriculum_updates
+  // (set_training_updates). 0 = off.
+  int64_t start_curriculum_updates = 0;
+  double start_curriculum_from = 0.25;
 };
 
 inline constexpr int kMaxOffenseAgents = 4;
@@ -132,6 +138,12 @@ class SoccerSim {
   // Starts an episode with a start state drawn from the configured distribution.
   void reset_episode();
   void reseed(uint64_t seed) { rng_.reseed(seed); }
+  // The learner's updates, for the start curriculum (SoccerSimConfig::start_curriculum_updates):
+  // the next reset_episode() moves its start toward the goal by the scale this gives. Until
+  // called, and with the curriculum off, starts are the distribution's own.
+  void set_training_updates(int64_t updates);
+  // The scale the next start is drawn with: 1 = the distribution's own.
+  [[nodiscard]] double start_scale() const { return start_scale_; }
 
   // Replaces the state (tests, traces). Referee counters restart at this state; with a goalie
   // configured, the goalie is put back at its start (kGoalieStart, at rest, full stamina).
@@ -223,6 +235,7 @@ class SoccerSim {
   Vec2 ball_accel_;
   Rng rng_;
   bool first_episode_ = true;
+  double start_scale_ = 1.0;  // set_training_updates
   GoalieCommandLog last_goalie_command_;
   GoalieCommandLog pending_goalie_command_;
   bool goalie_sensed_ = false;
