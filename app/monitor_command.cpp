@@ -258,6 +258,22 @@ nlohmann::json jnum(double v) {
   return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v);
 }
 
+// Calls f(target, peer, value) for each series `metric{peer="PEER"}` of each target that is up.
+template <typename F>
+void for_each_peer_series(const std::vector<Target>& ts, const std::string& metric, F f) {
+  const std::string prefix = metric + "{peer=\"";
+  for (const Target& t : ts) {
+    if (!t.up) {
+      continue;
+    }
+    for (const auto& [key, value] : t.now) {
+      if (key.rfind(prefix, 0) == 0) {
+        f(t, key.substr(prefix.size(), key.size() - prefix.size() - 2), value);
+      }
+    }
+  }
+}
+
 View build_view(const std::vector<Target>& ts, std::vector<double>& return_history, std::vector<double>& goal_history) {
   std::map<std::string, int> roles;
   int up = 0;
@@ -365,43 +381,30 @@ View build_view(const std::vector<Target>& ts, std::vector<double>& return_histo
   // view of an actor is left out: a shard holding inserts back reads nothing for a while.)
   nlohmann::json silent = nlohmann::json::array();
   std::string silent_list;
-  for (const Target& t : ts) {
-    if (!t.up) {
-      continue;
+  for_each_peer_series(ts, "pamdp_peer_silence_seconds", [&](const Target& t, const std::string& peer, double value) {
+    if (value < kSilentSeconds || (t.role != "learner" && peer != "learner")) {
+      return;
     }
-    const std::string prefix = "pamdp_peer_silence_seconds{peer=\"";
-    for (const auto& [key, value] : t.now) {
-      if (key.rfind(prefix, 0) != 0 || value < kSilentSeconds) {
-        continue;
-      }
-      const std::string peer = key.substr(prefix.size(), key.size() - prefix.size() - 2);
-      if (t.role != "learner" && peer != "learner") {
-        continue;
-      }
-      silent.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"silence_s", value}});
-      if (silent.size() <= 6) {
-        silent_list += (silent_list.empty() ? "" : ", ") + t.role + " -> " + peer + " " + num(value, 1) + " s";
-      }
+    silent.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"silence_s", value}});
+    if (silent.size() <= 6) {
+      silent_list += (silent_list.empty() ? "" : ", ") + t.role + " -> " + peer + " " + num(value, 1) + " s";
     }
-  }
+  });
   j["silent_peers"] = silent;
   // Frames refused for size, by whom and from whom (pamdp_peer_frames_refused_for_size_total).
   nlohmann::json oversized = nlohmann::json::array();
   std::string oversized_list;
-  for (const Target& t : ts) {
-    const std::string prefix = "pamdp_peer_frames_refused_for_size_total{peer=\"";
-    for (const auto& [key, value] : t.now) {
-      if (!t.up || key.rfind(prefix, 0) != 0 || value <= 0.0) {
-        continue;
-      }
-      const std::string peer = key.substr(prefix.size(), key.size() - prefix.size() - 2);
-      oversized.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"frames", value}});
-      if (oversized.size() <= 4) {
-        oversized_list.append(oversized_list.empty() ? "" : ", ").append(peer).append(" -> ").append(t.role);
-        oversized_list.append(" ").append(num(value));
-      }
-    }
-  }
+  for_each_peer_series(ts, "pamdp_peer_frames_refused_for_size_total",
+                       [&](const Target& t, const std::string& peer, double value) {
+                         if (value <= 0.0) {
+                           return;
+                         }
+                         oversized.push_back({{"observer", t.role + ":" + t.name}, {"peer", peer}, {"frames", value}});
+                         if (oversized.size() <= 4) {
+                           oversized_list.append(oversized_list.empty() ? "" : ", ").append(peer).append(" -> ");
+                           oversized_list.append(t.role).append(" ").append(num(value));
+                         }
+                       });
   j["oversized_frames"] = oversized;
 
   auto& L = v.lines;
