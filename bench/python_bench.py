@@ -6,7 +6,7 @@
 Rows: BM_SimStep (pamdp-bench, C++, the reference); one env's step() from Python with the same
 fixed action cycle as BM_SimStep (its overhead over the C++ step is the binding's cost); the
 vector env with random actions drawn in Python by action_space.sample() every step (N = 64 on
-one thread, hence one core, and a few other shapes). Each Python figure is the median of 3
+one thread, hence one core, and a few other shapes); the team vector env, 64 games of 2v1. Each Python figure is the median of 3
 runs. Targets: vector env >= 1 M env steps/s for N = 64 on one core; single step <= 3 us of
 overhead. For scale: EnvPool's published ~1 M Atari frames/s and ~3 M MuJoCo steps/s use 256
 CPU cores (a DGX-A100), i.e. ~4 k and ~12 k per core; the real HFO server runs "several
@@ -66,9 +66,14 @@ def single_step_ns(seconds: float, per_action_tuple: bool) -> float:
     return median_of_3(run)
 
 
-def vector_steps_per_s(seconds: float, num_envs: int, num_threads: int, copy: bool, env_id="hfo-1v0") -> float:
-    """Env steps per second of make_vec with random actions sampled in Python every step."""
-    vec = pamdp.make_vec(env_id, num_envs=num_envs, num_threads=num_threads, copy=copy)
+def vector_steps_per_s(seconds: float, num_envs: int, num_threads: int, copy: bool, env_id="hfo-1v0",
+                       agents: int = 0) -> float:
+    """Env steps (games' cycles) per second of make_vec, or of make_team_vec with `agents`
+    players a game, with random actions sampled in Python every step."""
+    if agents:
+        vec = pamdp.make_team_vec(env_id, agents=agents, num_envs=num_envs, num_threads=num_threads, copy=copy)
+    else:
+        vec = pamdp.make_vec(env_id, num_envs=num_envs, num_threads=num_threads, copy=copy)
     vec.reset(seed=1)
     vec.action_space.seed(1)
     sample, step = vec.action_space.sample, vec.step
@@ -104,6 +109,9 @@ def main():
                      f"{rate / 1e6:.2f} M env steps/s{target}"))
     rate = vector_steps_per_s(args.seconds, 64, 1, True, "hfo-1v1")
     rows.append(("make_vec hfo-1v1 N=64 threads=1, random actions", 1e9 / rate, f"{rate / 1e6:.2f} M env steps/s"))
+    rate = vector_steps_per_s(args.seconds, 64, 1, True, "hfo-1v1", agents=2)
+    rows.append(("make_team_vec hfo-1v1 agents=2 N=64 threads=1 (2v1)", 1e9 / rate,
+                 f"{rate / 1e6:.2f} M games' cycles/s, {2 * rate / 1e6:.2f} M player steps/s"))
 
     print(f"{'measurement':<58} {'ns/step':>9} {'steps/s':>11} {'x BM_SimStep':>13}  note")
     for name, ns, note in rows:

@@ -115,11 +115,13 @@ app::EnvConfig resolve_env(const std::string& id, const std::vector<std::pair<st
   }
 }
 
-std::unique_ptr<Env> build_env(const app::EnvConfig& config) {
-  if (config.params.contains("offense_agents") && config.params.integer("offense_agents") > 1 && config.name == "hfo") {
+std::unique_ptr<Env> build_env(const app::EnvConfig& config, bool team) {
+  if (!team && config.params.contains("offense_agents") && config.params.integer("offense_agents") > 1 &&
+      config.name == "hfo") {
     throw std::invalid_argument("offense_agents = " + std::to_string(config.params.integer("offense_agents")) +
                                 " is a team of learned players: pamdp.make_team(env_id, agents) plays it, one "
-                                "observation, action and reward per player");
+                                "observation, action and reward per player (pamdp.make_team_vec(env_id, agents, "
+                                "num_envs) steps many such games)");
   }
   return app::make_env(config);
 }

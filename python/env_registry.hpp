@@ -36,8 +36,10 @@ std::vector<std::string> option_names(const std::string& id);
 // std::invalid_argument naming the id or key, the problem and the valid choices.
 app::EnvConfig resolve_env(const std::string& id, const std::vector<std::pair<std::string, std::string>>& options);
 
-// A fresh env for `config`. Throws std::runtime_error when this build cannot make it.
-std::unique_ptr<Env> build_env(const app::EnvConfig& config);
+// A fresh env for `config`. Throws std::runtime_error when this build cannot make it. A team
+// (hfo with env.offense_agents > 1) is refused, naming make_team, unless `team` is true (the
+// team vector env, make_team_vec).
+std::unique_ptr<Env> build_env(const app::EnvConfig& config, bool team = false);
 
 // The id whose defaults `config` follows ("hfo-1v1" for hfo with the goalie), and a config file
 // holding `config` as its [env] table (every key, defaults included).

@@ -471,9 +471,12 @@ class PyTeamEnv {
 
 class PyVectorEnv {
  public:
+  // agents = 0: one player per env (make_vec). agents = A >= 1: a team vector env
+  // (make_team_vec), A learned players in each embedded HFO game, every per-player array with an
+  // agent axis (obs N x A x obs_size, reward N x A, actions N x A).
   PyVectorEnv(const std::string& id, const Options& options, int num_envs, int num_threads,
-              const std::string& autoreset, bool copy)
-      : config_(resolve_env(id, options)), copy_(copy) {
+              const std::string& autoreset, bool copy, int agents = 0)
+      : config_(resolve_env(id, with_agents(id, options, agents))), copy_(copy), team_(agents > 0) {
     if (num_envs < 1) {
       throw py::value_error("num_envs must be >= 1, got " + std::to_string(num_envs));
     }
@@ -488,28 +491,38 @@ class PyVectorEnv {
     }
     std::vector<std::unique_ptr<Env>> envs;
     for (int i = 0; i < num_envs; ++i) {
-      envs.push_back(build_env(config_));
+      envs.push_back(build_env(config_, team_));
     }
     facts_.emplace(*envs[0]);
     const int obs = facts_->obs_size;
     std::function<std::unique_ptr<Env>()> rebuild;
     if (fresh_env_per_seed(config_)) {
-      rebuild = [config = config_] { return build_env(config); };
+      rebuild = [config = config_, team = team_] { return build_env(config, team); };
     }
     vec_ = std::make_unique<VectorEnv>(std::move(envs), num_threads, mode, facts_->timeout_status, rebuild);
-    obs_ = py::array_t<float>({num_envs, obs});
-    reward_ = py::array_t<float>(num_envs);
+    const py::ssize_t players = vec_->agents();
+    const auto shape = [&](std::initializer_list<py::ssize_t> tail) {
+      std::vector<py::ssize_t> s{num_envs};
+      if (team_) {
+        s.push_back(players);
+      }
+      s.insert(s.end(), tail.begin(), tail.end());
+      return s;
+    };
+    obs_ = py::array_t<float>(shape({obs}));
+    reward_ = py::array_t<float>(shape({}));
     terminated_ = py::array_t<bool>(num_envs);
     truncated_ = py::array_t<bool>(num_envs);
     status_ = py::array_t<int32_t>(num_envs);
     same_step_ = mode == AutoReset::kSameStep;
     if (same_step_) {
-      final_obs_ = py::array_t<float>({num_envs, obs});
+      final_obs_ = py::array_t<float>(shape({obs}));
       has_final_ = py::array_t<bool>(num_envs);
       std::fill_n(final_obs_.mutable_data(), final_obs_.size(), 0.0F);
     }
-    ids_.resize(static_cast<size_t>(num_envs));
-    shared_.resize(static_cast<size_t>(num_envs) * static_cast<size_t>(facts_->space.num_params()), 0.0F);
+    const auto rows = static_cast<size_t>(num_envs) * static_cast<size_t>(players);
+    ids_.resize(rows);
+    shared_.resize(rows * static_cast<size_t>(facts_->space.num_params()), 0.0F);
   }
 
   py::tuple reset(py::handle seed, py::handle options) {
@@ -542,7 +555,8 @@ class PyVectorEnv {
     if (!was_reset_) {
       throw std::logic_error("vector env: step() before reset(); call reset() first");
     }
-    read_actions(action, *facts_, vec_->num_envs(), ids_, shared_);
+    // A team's actions arrive flattened to N x A rows (python/pamdp's TeamVectorEnv reshapes them).
+    read_actions(action, *facts_, vec_->num_envs() * vec_->agents(), ids_, shared_);
     {
       const py::gil_scoped_release unlocked;
       vec_->step(ids_, shared_, buffers());
@@ -556,9 +570,10 @@ class PyVectorEnv {
  private:
   VectorBuffers buffers() {
     const auto n = static_cast<size_t>(vec_->num_envs());
-    const size_t rows = n * static_cast<size_t>(facts_->obs_size);
+    const auto players = n * static_cast<size_t>(vec_->agents());
+    const size_t rows = players * static_cast<size_t>(facts_->obs_size);
     VectorBuffers b{{obs_.mutable_data(), rows},
-                    {reward_.mutable_data(), n},
+                    {reward_.mutable_data(), players},
                     {reinterpret_cast<uint8_t*>(terminated_.mutable_data()), n},
                     {reinterpret_cast<uint8_t*>(truncated_.mutable_data()), n},
                     {status_.mutable_data(), n},
@@ -584,8 +599,34 @@ class PyVectorEnv {
     return d;
   }
 
+  // The options with offense_agents = agents for a team (agents > 0); refuses a team of an env
+  // other than the embedded HFO, or of more players than it holds.
+  static Options with_agents(const std::string& id, const Options& options, int agents) {
+    if (agents == 0) {
+      return options;
+    }
+    if (agents < 1 || agents > hfo::kMaxOffenseAgents) {
+      throw py::value_error("agents must be within [1, " + std::to_string(hfo::kMaxOffenseAgents) + "], got " +
+                            std::to_string(agents));
+    }
+    Options out;
+    for (const auto& [key, value] : options) {
+      if (key == "offense_agents") {
+        throw py::value_error("make_team_vec takes the team's size as agents=..., not as offense_agents");
+      }
+      out.emplace_back(key, value);
+    }
+    if (resolve_env(id, out).name != "hfo") {
+      throw py::value_error("a team plays the embedded HFO simulator: give an hfo id (hfo-1v0, hfo-1v1, hfo), got '" +
+                            id + "'");
+    }
+    out.emplace_back("offense_agents", std::to_string(agents));
+    return out;
+  }
+
   app::EnvConfig config_;
   bool copy_;
+  bool team_ = false;
   std::optional<EnvFacts> facts_;
   std::unique_ptr<VectorEnv> vec_;
   py::array_t<float> obs_;
@@ -790,17 +831,19 @@ PYBIND11_MODULE(_pamdp, m) {
 
   py::class_<PyVectorEnv>(m, "VectorEnv", py::dynamic_attr())
       .def(py::init([](const std::string& id, const py::dict& options, int num_envs, int num_threads,
-                       const std::string& autoreset, bool copy) {
-             return std::make_unique<PyVectorEnv>(id, to_options(options), num_envs, num_threads, autoreset, copy);
+                       const std::string& autoreset, bool copy, int agents) {
+             return std::make_unique<PyVectorEnv>(id, to_options(options), num_envs, num_threads, autoreset, copy,
+                                                  agents);
            }),
            py::arg("env_id"), py::arg("options"), py::arg("num_envs"), py::arg("num_threads"),
-           py::arg("autoreset_mode"), py::arg("copy"))
+           py::arg("autoreset_mode"), py::arg("copy"), py::arg("agents") = 0)
       .def("reset", &PyVectorEnv::reset, py::arg("seed") = py::none(), py::arg("options") = py::none())
       .def("step", &PyVectorEnv::step, py::arg("actions"))
       .def_property_readonly("env_id", [](const PyVectorEnv& v) { return id_of(v.config()); })
       .def_property_readonly("config_toml", [](const PyVectorEnv& v) { return env_toml(v.config()); })
       .def_property_readonly("num_envs", [](const PyVectorEnv& v) { return v.vec().num_envs(); })
       .def_property_readonly("num_threads", [](const PyVectorEnv& v) { return v.vec().num_threads(); })
+      .def_property_readonly("num_agents", [](const PyVectorEnv& v) { return v.vec().agents(); })
       .def_property_readonly("observation_size", [](const PyVectorEnv& v) { return v.vec().observation_size(); })
       .def_property_readonly("observation_bound", [](const PyVectorEnv& v) { return observation_bound(v.config()); })
       .def_property_readonly("max_episode_steps",

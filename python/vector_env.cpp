@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace pamdp::python {
 
@@ -14,10 +15,18 @@ VectorEnv::VectorEnv(std::vector<std::unique_ptr<Env>> envs, int num_threads, Au
       rebuild_(std::move(rebuild)),
       obs_size_(envs_.empty() ? 0 : envs_[0]->observation_size()),
       num_params_(envs_.empty() ? 0 : envs_[0]->action_space().num_params()),
+      agents_(envs_.empty() ? 1 : envs_[0]->agents()),
+      actions_(envs_.size() * static_cast<size_t>(agents_)),
       needs_reset_(envs_.size(), 1),
       step_job_([this](int begin, int end) { step_slice(begin, end); }) {
   if (envs_.empty()) {
     throw std::invalid_argument("VectorEnv: needs at least one env");
+  }
+  for (const auto& env : envs_) {
+    if (env->agents() != agents_) {
+      throw std::invalid_argument("VectorEnv: every env needs the same number of players (" + std::to_string(agents_) +
+                                  "), got one of " + std::to_string(env->agents()));
+    }
   }
   for (int t = 1; t < num_threads_; ++t) {
     workers_.emplace_back([this, t] { worker(t); });
@@ -86,7 +95,8 @@ void VectorEnv::reset(std::span<const uint64_t> seeds, const VectorBuffers& out)
       env = rebuild_();
     }
   }
-  const auto obs = static_cast<size_t>(obs_size_);
+  const auto agents = static_cast<size_t>(agents_);
+  const auto obs = static_cast<size_t>(obs_size_) * agents;
   const std::function<void(int, int)> job = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       const auto k = static_cast<size_t>(i);
@@ -97,7 +107,7 @@ void VectorEnv::reset(std::span<const uint64_t> seeds, const VectorBuffers& out)
         envs_[k]->reset(seeds[k], row);
       }
       needs_reset_[k] = 0;
-      out.reward[k] = 0.0F;
+      std::fill_n(out.reward.begin() + static_cast<std::ptrdiff_t>(k * agents), agents, 0.0F);
       out.terminated[k] = 0;
       out.truncated[k] = 0;
       out.status[k] = 0;
@@ -117,23 +127,35 @@ void VectorEnv::step(std::span<const int> ids, std::span<const float> params, co
 }
 
 void VectorEnv::step_slice(int begin, int end) {
-  const auto obs = static_cast<size_t>(obs_size_);
+  const auto agents = static_cast<size_t>(agents_);
+  const auto obs = static_cast<size_t>(obs_size_) * agents;
   const auto np = static_cast<size_t>(num_params_);
   for (int i = begin; i < end; ++i) {
     const auto k = static_cast<size_t>(i);
     const std::span<float> row = out_.obs.subspan(k * obs, obs);
+    const std::span<float> rewards = out_.reward.subspan(k * agents, agents);
     Env& env = *envs_[k];
     if (needs_reset_[k] != 0) {  // kNextStep: the step after a terminal one starts the next episode
       env.reset(row);
       needs_reset_[k] = 0;
-      out_.reward[k] = 0.0F;
+      std::fill(rewards.begin(), rewards.end(), 0.0F);
       out_.terminated[k] = 0;
       out_.truncated[k] = 0;
       out_.status[k] = 0;
       continue;
     }
-    const StepResult r = env.step({ids_[k], params_.subspan(k * np, np)}, row);
-    out_.reward[k] = r.reward;
+    StepResult r;
+    if (agents_ == 1) {
+      r = env.step({ids_[k], params_.subspan(k * np, np)}, row);
+      rewards[0] = r.reward;
+    } else {
+      const std::span<ParamAction> actions = std::span(actions_).subspan(k * agents, agents);
+      for (size_t a = 0; a < agents; ++a) {
+        const size_t j = k * agents + a;
+        actions[a] = {ids_[j], params_.subspan(j * np, np)};
+      }
+      r = env.step_team(actions, row, rewards);
+    }
     out_.status[k] = r.status;
     const bool timeout = r.status == timeout_status_;
     out_.terminated[k] = r.terminal() && !timeout ? 1 : 0;

@@ -39,7 +39,8 @@ import numpy as np
 from . import _pamdp
 from . import spaces
 
-__all__ = ["Env", "EnvSpec", "VectorEnv", "ParallelEnv", "Policy", "make", "make_vec", "make_team", "load_policy", "evaluate", "env_ids",
+__all__ = ["Env", "EnvSpec", "VectorEnv", "ParallelEnv", "TeamVectorEnv", "Policy", "make", "make_vec", "make_team",
+           "make_team_vec", "load_policy", "evaluate", "env_ids",
            "spaces"]
 
 
@@ -248,6 +249,82 @@ class VectorEnv(_pamdp.VectorEnv):
         return f"pamdp.VectorEnv('{self.env_id}', num_envs={self.num_envs}, num_threads={self.num_threads})"
 
 
+class TeamVectorEnv(_pamdp.VectorEnv):
+    """num_envs embedded HFO games of `agents` learned players each (make_team's game), stepped
+    together in C++ (num_threads threads) into preallocated NumPy arrays, with an agent axis:
+    step(actions) -> (obs (N, A, obs), reward (N, A), terminated (N,), truncated (N,), info),
+    info["status"] the games' status codes (N,). Player a of game i is make_team's "offense_a":
+    obs[i, a] is its own observation and reward[i, a] its own reward; a game ends for all its
+    players at once. actions is (ids of shape (N, A), params), params a tuple of one (N, A, k)
+    float32 array per discrete action or one (N, A, num_params) array; action_space.sample()
+    draws such a batch. Autoreset, copy and seeding are VectorEnv's: reset(seed=s) seeds game i
+    with s + i, and game i then plays as make_team(env_id, agents).reset(seed=s + i) would."""
+
+    metadata = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, env_id: str = "hfo-1v1", agents: int = 2, num_envs: int = 1, num_threads: int = 1,
+                 autoreset_mode: str = "next_step", copy: bool = True, **options):
+        for name, value in (("agents", agents), ("num_envs", num_envs), ("num_threads", num_threads)):
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                raise TypeError(f"{name} must be an int, got {type(value).__name__}")
+        if not isinstance(autoreset_mode, str):
+            raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
+        super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
+                         bool(copy), int(agents))
+        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
+        self.possible_agents = [f"offense_{i}" for i in range(self.num_agents)]
+        bound = self.observation_bound
+        self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
+        self.single_action_space = spaces.action_space(self.actions)
+        self.observation_space = spaces.Box(-bound, bound, (self.num_envs, self.num_agents, self.observation_size),
+                                            np.float32)
+        self.action_space = spaces.action_space(self.actions, (self.num_envs, self.num_agents))
+
+    def step(self, actions):
+        """One cycle of every game: actions = (ids (N, A), params (N, A, ...)), as action_space."""
+        batch = (self.num_envs, self.num_agents)
+        rows = self.num_envs * self.num_agents
+        if not isinstance(actions, (tuple, list)) or len(actions) != 2:
+            raise TypeError(f"actions must be a pair (ids of shape {batch}, params), got {type(actions).__name__}"
+                            + (f" of {len(actions)} items" if isinstance(actions, (tuple, list)) else ""))
+        ids, params = actions
+        ids = np.asarray(ids)
+        if ids.shape != batch:
+            raise ValueError(f"actions[0], the discrete action ids, must have shape {batch} (games, agents), "
+                             f"got {ids.shape}")
+
+        def flat(a, what):
+            a = np.asarray(a, dtype=np.float32)
+            if a.ndim != 3 or a.shape[:2] != batch:
+                raise ValueError(f"{what} must have shape {batch} + (k,) (games, agents, parameters), got {a.shape}")
+            return a.reshape(rows, a.shape[2])
+
+        if isinstance(params, np.ndarray):
+            params = flat(params, "actions[1]")
+        elif isinstance(params, (tuple, list)):
+            params = tuple(flat(p, f"actions[1][{i}]") for i, p in enumerate(params))
+        return super().step((ids.reshape(rows), params))
+
+    @property
+    def unwrapped(self):
+        return self
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self):
+        return (f"pamdp.TeamVectorEnv('{self.env_id}', agents={self.num_agents}, num_envs={self.num_envs}, "
+                f"num_threads={self.num_threads})")
+
+
 class Policy(_pamdp.Policy):
     """A checkpoint's actor (of any learner, `algorithm`: "ddpg", "pdqn", "mpdqn"): policy(obs) for one observation (obs_size,) returns one action
     (id, params); for a batch (B, obs_size) it returns (ids (B,), params), the vector env's
@@ -373,6 +450,14 @@ def make_team(env_id: str = "hfo-1v1", agents: int = 2, **options) -> ParallelEn
     make_team("hfo-1v1", agents=2) is 2v1 against agent2d's goalie, make_team("hfo-1v0",
     agents=2) 2v0; env options as make's keyword arguments."""
     return ParallelEnv(env_id, agents, **options)
+
+
+def make_team_vec(env_id: str = "hfo-1v1", agents: int = 2, num_envs: int = 1, num_threads: int = 1,
+                  autoreset_mode: str = "next_step", copy: bool = True, **options) -> TeamVectorEnv:
+    """num_envs games of make_team(env_id, agents, **options) stepped in C++, every per-player
+    array with an agent axis (see TeamVectorEnv): make_team_vec("hfo-1v1", agents=2,
+    num_envs=64) is 64 games of 2v1 against agent2d's goalie."""
+    return TeamVectorEnv(env_id, agents, num_envs, num_threads, autoreset_mode, copy, **options)
 
 
 def make_vec(env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,

@@ -197,16 +197,19 @@ def action_space(actions, num_envs=None) -> Tuple:
     """The parameterized action space of an env (`actions`: per discrete action its name and its
     parameters as (name, lo, hi)): Tuple(Discrete(n), Tuple(Box per action)), MP-DQN's
     convention. With num_envs, the batch of num_envs such actions: Tuple(MultiDiscrete,
-    Tuple(Box of shape (num_envs, k) per action))."""
+    Tuple(Box of shape (num_envs, k) per action)); num_envs may be a shape, (num_envs, agents)
+    for a team vector env: ids of that shape, each Box (num_envs, agents, k)."""
+    batch = None if num_envs is None else tuple(np.atleast_1d(num_envs).astype(int).tolist())
     boxes = []
     for _name, params in actions:
         low = np.array([lo for _p, lo, _hi in params], dtype=np.float32)
         high = np.array([hi for _p, _lo, hi in params], dtype=np.float32)
-        if num_envs is None:
+        if batch is None:
             boxes.append(Box(low, high, (len(params),)))
         else:
-            boxes.append(Box(np.tile(low, (num_envs, 1)), np.tile(high, (num_envs, 1)), (num_envs, len(params))))
-    ids = Discrete(len(actions)) if num_envs is None else MultiDiscrete([len(actions)] * num_envs)
+            shape = batch + (len(params),)
+            boxes.append(Box(np.broadcast_to(low, shape), np.broadcast_to(high, shape), shape))
+    ids = Discrete(len(actions)) if batch is None else MultiDiscrete(np.full(batch, len(actions)))
     return ParameterizedActionSpace(ids, boxes)
 
 

@@ -1,6 +1,7 @@
 """Teams in Python (issue 79): pamdp.make_team, PettingZoo's parallel API without PettingZoo.
 Dicts keyed by agent name, one episode end for all, each player's own observation and reward,
-determinism under a seed, one agent equal to the one-player env, and the errors a caller meets."""
+determinism under a seed, one agent equal to the one-player env, and the errors a caller meets.
+pamdp.make_team_vec: many games with an agent axis, each game equal to make_team's."""
 
 import unittest
 
@@ -94,6 +95,63 @@ class TeamApi(unittest.TestCase):
             env.step({"offense_0": env.action_space("offense_0").sample()})
         with self.assertRaisesRegex(KeyError, "offense_2"):
             env.observation_space("offense_2")
+
+
+class TeamVectorEnvTest(unittest.TestCase):
+    def test_each_game_is_make_teams_game(self):
+        """Game i of make_team_vec(seed=s) against make_team reset with s + i, the same actions in,
+        through episode ends (next-step autoreset: the step after an end starts the next game)."""
+        n, agents = 3, 2
+        vec = pamdp.make_team_vec("hfo-1v1", agents=agents, num_envs=n, num_threads=2)
+        self.assertEqual(vec.observation_space.shape, (n, agents, 74))
+        games = [pamdp.make_team("hfo-1v1", agents=agents) for _ in range(n)]
+        obs, _ = vec.reset(seed=20)
+        self.assertEqual(obs.shape, (n, agents, 74))
+        names = games[0].possible_agents
+        for i, game in enumerate(games):
+            first, _ = game.reset(seed=20 + i)
+            np.testing.assert_array_equal(obs[i], np.stack([first[a] for a in names]))
+        vec.action_space.seed(3)
+        pending = [False] * n
+        ends = 0
+        for _ in range(500):
+            ids, params = vec.action_space.sample()
+            obs, reward, terminated, truncated, info = vec.step((ids, params))
+            self.assertEqual(reward.shape, (n, agents))
+            self.assertEqual(terminated.shape, (n,))
+            for i, game in enumerate(games):
+                if pending[i]:
+                    expected, _ = game.reset()
+                    pending[i] = False
+                    np.testing.assert_array_equal(reward[i], 0.0)
+                    self.assertFalse(terminated[i] or truncated[i])
+                else:
+                    actions = {a: (int(ids[i, k]), tuple(p[i, k] for p in params)) for k, a in enumerate(names)}
+                    expected, rewards, terms, truncs, infos = game.step(actions)
+                    np.testing.assert_array_equal(reward[i], np.array([rewards[a] for a in names], np.float32))
+                    self.assertEqual((bool(terminated[i]), bool(truncated[i])), (terms["offense_0"], truncs["offense_0"]))
+                    self.assertEqual(int(info["status"][i]), infos["offense_0"]["status"])
+                    pending[i] = terms["offense_0"] or truncs["offense_0"]
+                    ends += pending[i]
+                np.testing.assert_array_equal(obs[i], np.stack([expected[a] for a in names]))
+        self.assertGreater(ends, 3, "games must end for the autoreset to be checked")
+
+    def test_one_array_of_parameters_and_errors(self):
+        vec = pamdp.make_team_vec("hfo-1v0", agents=2, num_envs=2, noise=False)
+        vec.reset(seed=1)
+        ids = np.zeros((2, 2), dtype=np.int64)
+        obs, reward, *_ = vec.step((ids, np.zeros((2, 2, 6), dtype=np.float32)))
+        self.assertEqual(obs.shape, (2, 2, 66))
+        with self.assertRaisesRegex(ValueError, r"shape \(2, 2\)"):
+            vec.step((np.zeros(4, dtype=np.int64), np.zeros((2, 2, 6), dtype=np.float32)))
+        with self.assertRaisesRegex(ValueError, "games, agents, parameters"):
+            vec.step((ids, np.zeros((4, 6), dtype=np.float32)))
+        with self.assertRaisesRegex(ValueError, "hfo id"):
+            pamdp.make_team_vec("platform", agents=2)
+        with self.assertRaisesRegex(ValueError, r"agents must be within \[1, 4\]"):
+            pamdp.make_team_vec("hfo-1v1", agents=5)
+        with self.assertRaisesRegex(ValueError, "make_team_vec"):
+            pamdp.make_vec("hfo-1v1", num_envs=2, offense_agents=2)
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@
 
 #include "core/rng.hpp"
 #include "envs/hfo/hfo_env.hpp"
+#include "envs/hfo/hfo_team_env.hpp"
 #include "python/vector_env.hpp"
 #include "tests/counting_new.hpp"
 
@@ -23,11 +24,20 @@ std::vector<std::unique_ptr<Env>> hfo_envs(int n) {
   return envs;
 }
 
+// n 2v1 games (two learned players against agent2d's goalie).
+std::vector<std::unique_ptr<Env>> team_envs(int n) {
+  std::vector<std::unique_ptr<Env>> envs;
+  for (int i = 0; i < n; ++i) {
+    envs.push_back(std::make_unique<hfo::HfoTeamEnv>(hfo::SoccerSimConfig{.goalie = true, .offense_agents = 2}));
+  }
+  return envs;
+}
+
 // Everything a vector env writes, owned here as the NumPy arrays are in the module.
 struct Batch {
-  Batch(int n, int obs_size, bool same_step)
-      : obs(static_cast<size_t>(n * obs_size)),
-        reward(static_cast<size_t>(n)),
+  Batch(int n, int obs_size, bool same_step, int agents = 1)
+      : obs(static_cast<size_t>(n * agents * obs_size)),
+        reward(static_cast<size_t>(n * agents)),
         terminated(static_cast<size_t>(n)),
         truncated(static_cast<size_t>(n)),
         status(static_cast<size_t>(n)),
@@ -148,6 +158,88 @@ TEST(VectorEnv, StepAllocatesNothing) {
       EXPECT_EQ(counter.count(), 0) << threads << " threads";
     }
   }
+}
+
+// A team vector env: game i's players take rows i * A .. i * A + A - 1 of the actions, and every
+// game plays as a plain team env stepped with step_team, obs and rewards player-major.
+TEST(VectorEnv, ATeamMatchesPlainTeamGames) {
+  constexpr int kN = 3;
+  constexpr int kA = 2;
+  VectorEnv vec(team_envs(kN), 2, AutoReset::kNextStep, kTimeout);
+  ASSERT_EQ(vec.agents(), kA);
+  auto plain = team_envs(kN);
+  Batch batch(kN, vec.observation_size(), false, kA);
+  const std::vector<uint64_t> seeds{3, 4, 5};
+  vec.reset(seeds, batch.buffers());
+  const auto width = static_cast<size_t>(vec.observation_size()) * kA;
+  std::vector<float> obs(width);
+  std::vector<float> rewards(kA);
+  std::vector<bool> pending(kN, false);
+  for (size_t i = 0; i < kN; ++i) {
+    plain[i]->reset(seeds[i], obs);
+    ASSERT_TRUE(std::equal(obs.begin(), obs.end(), batch.obs.begin() + static_cast<std::ptrdiff_t>(i * width)));
+  }
+  Rng rng(11);
+  std::vector<int> ids(kN * kA);
+  std::vector<float> params(kN * kA * 6);
+  std::vector<ParamAction> actions(kA);
+  int ends = 0;
+  for (int step = 0; step < 600; ++step) {
+    draw(rng, ids, params);
+    vec.step(ids, params, batch.buffers());
+    for (size_t i = 0; i < kN; ++i) {
+      Env& env = *plain[i];
+      if (pending[i]) {
+        env.reset(obs);
+        pending[i] = false;
+        EXPECT_EQ(batch.reward[i * kA], 0.0F);
+        EXPECT_EQ(batch.reward[i * kA + 1], 0.0F);
+        EXPECT_EQ(batch.status[i], 0);
+      } else {
+        for (size_t a = 0; a < kA; ++a) {
+          actions[a] = {ids[i * kA + a], std::span<const float>(params).subspan((i * kA + a) * 6, 6)};
+        }
+        const StepResult r = env.step_team(actions, obs, rewards);
+        EXPECT_EQ(batch.reward[i * kA], rewards[0]);
+        EXPECT_EQ(batch.reward[i * kA + 1], rewards[1]);
+        EXPECT_EQ(batch.status[i], r.status);
+        EXPECT_EQ(batch.truncated[i], r.status == kTimeout ? 1 : 0);
+        EXPECT_EQ(batch.terminated[i], r.terminal() && r.status != kTimeout ? 1 : 0);
+        pending[i] = r.terminal();
+        ends += r.terminal() ? 1 : 0;
+      }
+      ASSERT_TRUE(std::equal(obs.begin(), obs.end(), batch.obs.begin() + static_cast<std::ptrdiff_t>(i * width)))
+          << "game " << i << " step " << step;
+    }
+  }
+  EXPECT_GT(ends, 3) << "the games must end and restart for the test to check autoreset";
+}
+
+TEST(VectorEnv, ATeamStepAllocatesNothing) {
+  for (const AutoReset mode : {AutoReset::kNextStep, AutoReset::kSameStep}) {
+    constexpr int kN = 4;
+    constexpr int kA = 2;
+    VectorEnv vec(team_envs(kN), 2, mode, kTimeout);
+    Batch batch(kN, vec.observation_size(), mode == AutoReset::kSameStep, kA);
+    vec.reset({}, batch.buffers());
+    Rng rng(2);
+    std::vector<int> ids(kN * kA);
+    std::vector<float> params(kN * kA * 6);
+    draw(rng, ids, params);
+    vec.step(ids, params, batch.buffers());  // warm up
+    testing::alloc::CountAllocations counter;
+    for (int step = 0; step < 300; ++step) {
+      draw(rng, ids, params);
+      vec.step(ids, params, batch.buffers());
+    }
+    EXPECT_EQ(counter.count(), 0);
+  }
+}
+
+TEST(VectorEnv, RefusesEnvsOfDifferentTeamSizes) {
+  std::vector<std::unique_ptr<Env>> envs = team_envs(1);
+  envs.push_back(std::make_unique<hfo::HfoEnv>(hfo::SoccerSimConfig{.goalie = true}));
+  EXPECT_THROW(VectorEnv(std::move(envs), 1, AutoReset::kNextStep, kTimeout), std::invalid_argument);
 }
 
 }  // namespace
