@@ -196,7 +196,46 @@ class Env(_pamdp.Env):
         return f"pamdp.Env('{self.env_id}')"
 
 
-class VectorEnv(_pamdp.VectorEnv):
+class _BatchedEnv(_pamdp.VectorEnv):
+    """What VectorEnv and TeamVectorEnv share: the argument checks, the spaces (a batch of
+    num_envs, or of (num_envs, agents) for a team: agents > 0) and Gymnasium's vector-env
+    conveniences."""
+
+    metadata = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, env_id, num_envs, num_threads, autoreset_mode, copy, options, agents=0):
+        for name, value in (("agents", agents), ("num_envs", num_envs), ("num_threads", num_threads)):
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                raise TypeError(f"{name} must be an int, got {type(value).__name__}")
+        if not isinstance(autoreset_mode, str):
+            raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
+        super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
+                         bool(copy), int(agents))
+        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
+        batch = (self.num_envs, self.num_agents) if agents else (self.num_envs,)
+        bound = self.observation_bound
+        self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
+        self.single_action_space = spaces.action_space(self.actions)
+        self.observation_space = spaces.Box(-bound, bound, batch + (self.observation_size,), np.float32)
+        self.action_space = spaces.action_space(self.actions, batch)
+
+    @property
+    def unwrapped(self):
+        return self
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class VectorEnv(_BatchedEnv):
     """num_envs envs stepped together in C++ (num_threads threads), writing into preallocated
     NumPy arrays: step(actions) -> (obs (N, obs), reward (N,), terminated (N,), truncated (N,),
     info) with info["status"] the envs' status codes. actions is (ids of shape (N,), params),
@@ -212,44 +251,15 @@ class VectorEnv(_pamdp.VectorEnv):
     reset(seed=s) seeds env i with s + i (a sequence gives each env its own); the first reset
     without a seed uses 0 + i."""
 
-    metadata = {"render_modes": []}
-    render_mode = None
-    spec = None
-
     def __init__(self, env_id: str = "hfo-1v0", num_envs: int = 1, num_threads: int = 1,
                  autoreset_mode: str = "next_step", copy: bool = True, **options):
-        for name, value in (("num_envs", num_envs), ("num_threads", num_threads)):
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-                raise TypeError(f"{name} must be an int, got {type(value).__name__}")
-        if not isinstance(autoreset_mode, str):
-            raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
-        super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
-                         bool(copy))
-        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
-        bound = self.observation_bound
-        self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
-        self.single_action_space = spaces.action_space(self.actions)
-        self.observation_space = spaces.Box(-bound, bound, (self.num_envs, self.observation_size), np.float32)
-        self.action_space = spaces.action_space(self.actions, self.num_envs)
-
-    @property
-    def unwrapped(self):
-        return self
-
-    def close(self):
-        pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
+        super().__init__(env_id, num_envs, num_threads, autoreset_mode, copy, options)
 
     def __repr__(self):
         return f"pamdp.VectorEnv('{self.env_id}', num_envs={self.num_envs}, num_threads={self.num_threads})"
 
 
-class TeamVectorEnv(_pamdp.VectorEnv):
+class TeamVectorEnv(_BatchedEnv):
     """num_envs embedded HFO games of `agents` learned players each (make_team's game), stepped
     together in C++ (num_threads threads) into preallocated NumPy arrays, with an agent axis:
     step(actions) -> (obs (N, A, obs), reward (N, A), terminated (N,), truncated (N,), info),
@@ -260,27 +270,10 @@ class TeamVectorEnv(_pamdp.VectorEnv):
     draws such a batch. Autoreset, copy and seeding are VectorEnv's: reset(seed=s) seeds game i
     with s + i, and game i then plays as make_team(env_id, agents).reset(seed=s + i) would."""
 
-    metadata = {"render_modes": []}
-    render_mode = None
-    spec = None
-
     def __init__(self, env_id: str = "hfo-1v1", agents: int = 2, num_envs: int = 1, num_threads: int = 1,
                  autoreset_mode: str = "next_step", copy: bool = True, **options):
-        for name, value in (("agents", agents), ("num_envs", num_envs), ("num_threads", num_threads)):
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-                raise TypeError(f"{name} must be an int, got {type(value).__name__}")
-        if not isinstance(autoreset_mode, str):
-            raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
-        super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
-                         bool(copy), int(agents))
-        self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
+        super().__init__(env_id, num_envs, num_threads, autoreset_mode, copy, options, agents)
         self.possible_agents = [f"offense_{i}" for i in range(self.num_agents)]
-        bound = self.observation_bound
-        self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
-        self.single_action_space = spaces.action_space(self.actions)
-        self.observation_space = spaces.Box(-bound, bound, (self.num_envs, self.num_agents, self.observation_size),
-                                            np.float32)
-        self.action_space = spaces.action_space(self.actions, (self.num_envs, self.num_agents))
 
     def step(self, actions):
         """One cycle of every game: actions = (ids (N, A), params (N, A, ...)), as action_space."""
@@ -306,19 +299,6 @@ class TeamVectorEnv(_pamdp.VectorEnv):
         elif isinstance(params, (tuple, list)):
             params = tuple(flat(p, f"actions[1][{i}]") for i, p in enumerate(params))
         return super().step((ids.reshape(rows), params))
-
-    @property
-    def unwrapped(self):
-        return self
-
-    def close(self):
-        pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def __repr__(self):
         return (f"pamdp.TeamVectorEnv('{self.env_id}', agents={self.num_agents}, num_envs={self.num_envs}, "

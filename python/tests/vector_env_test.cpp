@@ -138,24 +138,30 @@ TEST(VectorEnv, MatchesPlainEnvs) {
   }
 }
 
+// Allocations in 300 steps of a warmed-up vector env over `envs` (agents() players each).
+int64_t step_allocations(std::vector<std::unique_ptr<Env>> envs, int threads, AutoReset mode) {
+  const int n = static_cast<int>(envs.size());
+  VectorEnv vec(std::move(envs), threads, mode, kTimeout);
+  const int rows = n * vec.agents();
+  Batch batch(n, vec.observation_size(), mode == AutoReset::kSameStep, vec.agents());
+  vec.reset({}, batch.buffers());
+  Rng rng(1);
+  std::vector<int> ids(static_cast<size_t>(rows));
+  std::vector<float> params(static_cast<size_t>(rows) * 6);
+  draw(rng, ids, params);
+  vec.step(ids, params, batch.buffers());  // warm up
+  testing::alloc::CountAllocations counter;
+  for (int step = 0; step < 300; ++step) {
+    draw(rng, ids, params);
+    vec.step(ids, params, batch.buffers());
+  }
+  return counter.count();
+}
+
 TEST(VectorEnv, StepAllocatesNothing) {
   for (const int threads : {1, 3}) {
     for (const AutoReset mode : {AutoReset::kNextStep, AutoReset::kSameStep}) {
-      constexpr int kN = 8;
-      VectorEnv vec(hfo_envs(kN), threads, mode, kTimeout);
-      Batch batch(kN, vec.observation_size(), mode == AutoReset::kSameStep);
-      vec.reset({}, batch.buffers());
-      Rng rng(1);
-      std::vector<int> ids(kN);
-      std::vector<float> params(kN * 6);
-      draw(rng, ids, params);
-      vec.step(ids, params, batch.buffers());  // warm up
-      testing::alloc::CountAllocations counter;
-      for (int step = 0; step < 300; ++step) {
-        draw(rng, ids, params);
-        vec.step(ids, params, batch.buffers());
-      }
-      EXPECT_EQ(counter.count(), 0) << threads << " threads";
+      EXPECT_EQ(step_allocations(hfo_envs(8), threads, mode), 0) << threads << " threads";
     }
   }
 }
@@ -217,22 +223,7 @@ TEST(VectorEnv, ATeamMatchesPlainTeamGames) {
 
 TEST(VectorEnv, ATeamStepAllocatesNothing) {
   for (const AutoReset mode : {AutoReset::kNextStep, AutoReset::kSameStep}) {
-    constexpr int kN = 4;
-    constexpr int kA = 2;
-    VectorEnv vec(team_envs(kN), 2, mode, kTimeout);
-    Batch batch(kN, vec.observation_size(), mode == AutoReset::kSameStep, kA);
-    vec.reset({}, batch.buffers());
-    Rng rng(2);
-    std::vector<int> ids(kN * kA);
-    std::vector<float> params(kN * kA * 6);
-    draw(rng, ids, params);
-    vec.step(ids, params, batch.buffers());  // warm up
-    testing::alloc::CountAllocations counter;
-    for (int step = 0; step < 300; ++step) {
-      draw(rng, ids, params);
-      vec.step(ids, params, batch.buffers());
-    }
-    EXPECT_EQ(counter.count(), 0);
+    EXPECT_EQ(step_allocations(team_envs(4), 2, mode), 0);
   }
 }
 
