@@ -144,18 +144,13 @@ void VectorEnv::step_slice(int begin, int end) {
       out_.status[k] = 0;
       continue;
     }
-    StepResult r;
-    if (agents_ == 1) {
-      r = env.step({ids_[k], params_.subspan(k * np, np)}, row);
-      rewards[0] = r.reward;
-    } else {
-      const std::span<ParamAction> actions = std::span(actions_).subspan(k * agents, agents);
-      for (size_t a = 0; a < agents; ++a) {
-        const size_t j = k * agents + a;
-        actions[a] = {ids_[j], params_.subspan(j * np, np)};
-      }
-      r = env.step_team(actions, row, rewards);
+    // Env::step_team: a team's step, or for one player its step().
+    const std::span<ParamAction> actions = std::span(actions_).subspan(k * agents, agents);
+    for (size_t a = 0; a < agents; ++a) {
+      const size_t j = k * agents + a;
+      actions[a] = {ids_[j], params_.subspan(j * np, np)};
     }
+    const StepResult r = env.step_team(actions, row, rewards);
     out_.status[k] = r.status;
     const bool timeout = r.status == timeout_status_;
     out_.terminated[k] = r.terminal() && !timeout ? 1 : 0;
