@@ -6,11 +6,11 @@
 Rows: BM_SimStep (pamdp-bench, C++, the reference); one env's step() from Python with the same
 fixed action cycle as BM_SimStep (its overhead over the C++ step is the binding's cost); the
 vector env with random actions drawn in Python by action_space.sample() every step (N = 64 on
-one thread, hence one core, and a few other shapes); the team vector env, 64 games of 2v1. Each Python figure is the median of 3
-runs. Targets: vector env >= 1 M env steps/s for N = 64 on one core; single step <= 3 us of
-overhead. For scale: EnvPool's published ~1 M Atari frames/s and ~3 M MuJoCo steps/s use 256
-CPU cores (a DGX-A100), i.e. ~4 k and ~12 k per core; the real HFO server runs "several
-hundred FPS" (LARG/HFO issue #60).
+one thread, hence one core, and a few other shapes); the team vector env, 64 games of 2v1.
+Each Python figure is the median of 3 runs. Targets: vector env >= 1 M env steps/s for N = 64
+on one core; single step <= 3 us of overhead. For scale: EnvPool's published ~1 M Atari
+frames/s and ~3 M MuJoCo steps/s use 256 CPU cores (a DGX-A100), i.e. ~4 k and ~12 k per core;
+the real HFO server runs "several hundred FPS" (LARG/HFO issue #60).
 """
 
 import argparse

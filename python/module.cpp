@@ -374,19 +374,25 @@ class PyEnv {
   int last_status_ = 0;
 };
 
+// What every team (make_team, make_team_vec) checks: `config` (of id `id`) is the embedded HFO
+// simulator, and `agents` within the players it holds.
+void check_team(const app::EnvConfig& config, const std::string& id, int agents) {
+  if (config.name != "hfo") {
+    throw py::value_error("a team plays the embedded HFO simulator: give an hfo id (hfo-1v0, hfo-1v1, hfo), got '" +
+                          id + "'");
+  }
+  if (agents < 1 || agents > hfo::kMaxOffenseAgents) {
+    throw py::value_error("agents must be within [1, " + std::to_string(hfo::kMaxOffenseAgents) + "], got " +
+                          std::to_string(agents));
+  }
+}
+
 // N offense agents in one embedded HFO game (envs/hfo/hfo_team_env.hpp), for python/pamdp's
 // ParallelEnv: one observation, action and reward per agent, in player order.
 class PyTeamEnv {
  public:
   PyTeamEnv(const std::string& id, int agents, const Options& options) : config_(resolve_env(id, options)) {
-    if (config_.name != "hfo") {
-      throw py::value_error("a team plays the embedded HFO simulator: give an hfo id (hfo-1v0, hfo-1v1, hfo), got '" +
-                            id + "'");
-    }
-    if (agents < 1 || agents > hfo::kMaxOffenseAgents) {
-      throw py::value_error("agents must be within [1, " + std::to_string(hfo::kMaxOffenseAgents) + "], got " +
-                            std::to_string(agents));
-    }
+    check_team(config_, id, agents);
     hfo::SoccerSimConfig c = hfo::sim_config(config_.params);
     c.offense_agents = agents;
     env_ = std::make_unique<hfo::HfoTeamEnv>(c, config_.params.boolean("shoot_action"),
@@ -471,12 +477,12 @@ class PyTeamEnv {
 
 class PyVectorEnv {
  public:
-  // agents = 0: one player per env (make_vec). agents = A >= 1: a team vector env
-  // (make_team_vec), A learned players in each embedded HFO game, every per-player array with an
-  // agent axis (obs N x A x obs_size, reward N x A, actions N x A).
+  // No agents: one player per env (make_vec). agents = A: a team vector env (make_team_vec), A
+  // learned players in each embedded HFO game (check_team), every per-player array with an agent
+  // axis (obs N x A x obs_size, reward N x A, actions N x A).
   PyVectorEnv(const std::string& id, const Options& options, int num_envs, int num_threads,
-              const std::string& autoreset, bool copy, int agents = 0)
-      : config_(resolve_env(id, with_agents(id, options, agents))), copy_(copy), team_(agents > 0) {
+              const std::string& autoreset, bool copy, std::optional<int> agents = std::nullopt)
+      : config_(resolve_env(id, with_agents(id, options, agents))), copy_(copy), team_(agents.has_value()) {
     if (num_envs < 1) {
       throw py::value_error("num_envs must be >= 1, got " + std::to_string(num_envs));
     }
@@ -599,15 +605,10 @@ class PyVectorEnv {
     return d;
   }
 
-  // The options with offense_agents = agents for a team (agents > 0); refuses a team of an env
-  // other than the embedded HFO, or of more players than it holds.
-  static Options with_agents(const std::string& id, const Options& options, int agents) {
-    if (agents == 0) {
+  // The options with offense_agents = agents for a team, after check_team.
+  static Options with_agents(const std::string& id, const Options& options, std::optional<int> agents) {
+    if (!agents) {
       return options;
-    }
-    if (agents < 1 || agents > hfo::kMaxOffenseAgents) {
-      throw py::value_error("agents must be within [1, " + std::to_string(hfo::kMaxOffenseAgents) + "], got " +
-                            std::to_string(agents));
     }
     Options out;
     for (const auto& [key, value] : options) {
@@ -616,11 +617,8 @@ class PyVectorEnv {
       }
       out.emplace_back(key, value);
     }
-    if (resolve_env(id, out).name != "hfo") {
-      throw py::value_error("a team plays the embedded HFO simulator: give an hfo id (hfo-1v0, hfo-1v1, hfo), got '" +
-                            id + "'");
-    }
-    out.emplace_back("offense_agents", std::to_string(agents));
+    check_team(resolve_env(id, out), id, *agents);
+    out.emplace_back("offense_agents", std::to_string(*agents));
     return out;
   }
 
@@ -831,12 +829,12 @@ PYBIND11_MODULE(_pamdp, m) {
 
   py::class_<PyVectorEnv>(m, "VectorEnv", py::dynamic_attr())
       .def(py::init([](const std::string& id, const py::dict& options, int num_envs, int num_threads,
-                       const std::string& autoreset, bool copy, int agents) {
+                       const std::string& autoreset, bool copy, std::optional<int> agents) {
              return std::make_unique<PyVectorEnv>(id, to_options(options), num_envs, num_threads, autoreset, copy,
                                                   agents);
            }),
            py::arg("env_id"), py::arg("options"), py::arg("num_envs"), py::arg("num_threads"),
-           py::arg("autoreset_mode"), py::arg("copy"), py::arg("agents") = 0)
+           py::arg("autoreset_mode"), py::arg("copy"), py::arg("agents") = py::none())
       .def("reset", &PyVectorEnv::reset, py::arg("seed") = py::none(), py::arg("options") = py::none())
       .def("step", &PyVectorEnv::step, py::arg("actions"))
       .def_property_readonly("env_id", [](const PyVectorEnv& v) { return id_of(v.config()); })

@@ -198,23 +198,24 @@ class Env(_pamdp.Env):
 
 class _BatchedEnv(_pamdp.VectorEnv):
     """What VectorEnv and TeamVectorEnv share: the argument checks, the spaces (a batch of
-    num_envs, or of (num_envs, agents) for a team: agents > 0) and Gymnasium's vector-env
+    num_envs, or of (num_envs, agents) for a team: agents given) and Gymnasium's vector-env
     conveniences."""
 
     metadata = {"render_modes": []}
     render_mode = None
     spec = None
 
-    def __init__(self, env_id, num_envs, num_threads, autoreset_mode, copy, options, agents=0):
-        for name, value in (("agents", agents), ("num_envs", num_envs), ("num_threads", num_threads)):
+    def __init__(self, env_id, num_envs, num_threads, autoreset_mode, copy, options, agents=None):
+        team = agents is not None
+        for name, value in (("agents", agents if team else 0), ("num_envs", num_envs), ("num_threads", num_threads)):
             if isinstance(value, bool) or not isinstance(value, numbers.Integral):
                 raise TypeError(f"{name} must be an int, got {type(value).__name__}")
         if not isinstance(autoreset_mode, str):
             raise TypeError(f"autoreset_mode must be a str, got {type(autoreset_mode).__name__}")
         super().__init__(env_id, _options(env_id, options), int(num_envs), int(num_threads), autoreset_mode,
-                         bool(copy), int(agents))
+                         bool(copy), int(agents) if team else None)
         self.metadata = {"render_modes": [], "autoreset_mode": autoreset_mode}
-        batch = (self.num_envs, self.num_agents) if agents else (self.num_envs,)
+        batch = (self.num_envs, self.num_agents) if team else (self.num_envs,)
         bound = self.observation_bound
         self.single_observation_space = spaces.Box(-bound, bound, (self.observation_size,), np.float32)
         self.single_action_space = spaces.action_space(self.actions)
@@ -272,6 +273,8 @@ class TeamVectorEnv(_BatchedEnv):
 
     def __init__(self, env_id: str = "hfo-1v1", agents: int = 2, num_envs: int = 1, num_threads: int = 1,
                  autoreset_mode: str = "next_step", copy: bool = True, **options):
+        if agents is None:  # the base class reads None as make_vec's env
+            raise TypeError("agents must be an int, got NoneType")
         super().__init__(env_id, num_envs, num_threads, autoreset_mode, copy, options, agents)
         self.possible_agents = [f"offense_{i}" for i in range(self.num_agents)]
 

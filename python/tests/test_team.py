@@ -150,6 +150,10 @@ class TeamVectorEnvTest(unittest.TestCase):
             pamdp.make_team_vec("platform", agents=2)
         with self.assertRaisesRegex(ValueError, r"agents must be within \[1, 4\]"):
             pamdp.make_team_vec("hfo-1v1", agents=5)
+        with self.assertRaisesRegex(ValueError, r"agents must be within \[1, 4\]"):
+            pamdp.make_team_vec("hfo-1v1", agents=0)
+        with self.assertRaises(TypeError):
+            pamdp.make_team_vec("hfo-1v1", agents=None)
         with self.assertRaisesRegex(ValueError, "make_team_vec"):
             pamdp.make_vec("hfo-1v1", num_envs=2, offense_agents=2)
 
