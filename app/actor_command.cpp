@@ -49,6 +49,7 @@ struct ActorCliOptions {
   int metrics_port = 0;
   std::string server_host;  // overrides env.server_host (env.name = "hfo-server")
   int server_port = 0;      // overrides env.server_port; 0 = the cluster's
+  int server_agents = 0;    // overrides env.server_agents; 0 = the cluster's
 };
 
 std::string default_name() {
@@ -106,6 +107,13 @@ void run_actor(const ActorCliOptions& o) {
   }
   if (o.server_port > 0) {
     config.env.params.set("server_port", int64_t{o.server_port});
+  }
+  if (o.server_agents > 0) {
+    if (!config.env.params.contains("server_agents")) {
+      throw std::runtime_error("--server-agents: the cluster plays env '" + config.env.name +
+                               "'; only env 'hfo-server' has agents on a server (leave out --server-agents)");
+    }
+    config.env.params.set("server_agents", int64_t{o.server_agents});
   }
   const EnvRegistration& registration = env_registry().find(config.env.name);
   if (registration.max_per_process > 0 && o.envs > registration.max_per_process) {
@@ -214,6 +222,10 @@ void register_actor(CLI::App& app) {
   cmd->add_option("--server-port", o->server_port,
                   "env 'hfo-server': port of this actor's HFO server (default: the cluster's env.server_port)")
       ->check(CLI::Range(1, 65535));
+  cmd->add_option("--server-agents", o->server_agents,
+                  "env 'hfo-server': how many of its server's agents (env.offense_agents) this actor plays, in "
+                  "lockstep (default: the cluster's env.server_agents)")
+      ->check(CLI::Range(1, 4));
   cmd->add_option("--log-level", "trace, debug, info, warn, error or off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
       ->each([](const std::string& level) { log::set_level(level); });

@@ -332,17 +332,23 @@ void run_team_eval(const EvalOptions& o, const CLI::App& cmd) {
         "--offense-agents plays a team of scripted or random players; --trace, --agreement, --shot and --actor are "
         "for one agent: leave them out, or leave out --offense-agents");
   }
-  if (!o.env.empty() && o.env != "hfo") {
+  const bool server = o.env == "hfo-server";
+  if (!o.env.empty() && o.env != "hfo" && !server) {
     throw std::runtime_error(
-        "--offense-agents plays the embedded simulator; on the real server each agent is a "
-        "process of its own: --env hfo-server --set env.offense_agents=" +
-        std::to_string(o.offense_agents) + " in each");
+        "--offense-agents plays a team of HFO: --env hfo (the embedded simulator) or --env "
+        "hfo-server (all N agents of one real server, env.server_agents = N)");
   }
   ExperimentConfig c;
-  c.env.name = "hfo";
+  c.env.name = server ? "hfo-server" : "hfo";
   hfo::SoccerSimConfig cfg = o.sim.resolved();
   cfg.offense_agents = o.offense_agents;
   hfo::set_sim_config(c.env.params, cfg);
+  if (server) {
+    // One process plays every agent of the server, each reading the embedded features.
+    refuse_unread_sim_options(cmd, c.env.name);
+    c.env.params.set("server_agents", int64_t{o.offense_agents});
+    (void)env_registry().find(c.env.name).use_embedded_hfo_features(c.env.params);
+  }
   c = with_env_overrides(c, o.sets);
   if (c.env.params.integer("offense_agents") != o.offense_agents) {
     throw std::runtime_error("--set env.offense_agents and --offense-agents disagree: give one of them");

@@ -6,12 +6,14 @@
 #
 #   deploy/hfo-server-actors.sh --hfo-root DIR --join tcp://LEARNER:5555 [--actors N]
 #                               [--base-port P] [--seed S] [--log-dir DIR] [--goalie]
-#                               [--offense-agents M] [--curve-keys DIR | --insecure]
+#                               [--offense-agents M [--team-actor]] [--curve-keys DIR | --insecure]
 #
 # A team game (--offense-agents M, 1-4): each server runs bin/HFO --offense-agents M and M actors
 # join it, one per player (actor i's players are logged as actor-i-k.log); the server plays them
 # in lockstep, and if any of them stops the M actors and their server are restarted together. The
 # learner then needs env.offense_agents=M, so that each player's features hold its teammates.
+# With --team-actor one actor per server plays all M players (pamdp actor --server-agents M: a
+# thread per player, joining env.server_join_interval_ms apart), logged as actor-i.log.
 #
 # Defaults: 1 actor, base port 7000, seed 1 (server i of restart r: S + 100 i + r), logs in
 # runs/hfo-servers. The learner runs with --set env.name=hfo-server (and train.eval_episodes=0,
@@ -33,6 +35,7 @@ seed=1
 log_dir=runs/hfo-servers
 goalie=0
 agents=1
+team_actor=0
 security=()
 
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
@@ -49,6 +52,7 @@ while [[ $# -gt 0 ]]; do
     --log-dir) need_value "$@"; log_dir=$2; shift 2 ;;
     --goalie) goalie=1; shift ;;
     --offense-agents) need_value "$@"; agents=$2; shift 2 ;;
+    --team-actor) team_actor=1; shift ;;
     --curve-keys) need_value "$@"; security=(--curve-keys "$2"); shift 2 ;;
     --insecure) security=(--insecure); shift ;;
     -h|--help) usage; exit 0 ;;
@@ -64,6 +68,7 @@ hfo_root=$(cd "$hfo_root" 2>/dev/null && pwd) || die "--hfo-root: no such direct
   die "--base-port must leave room for $actors servers 10 ports apart below 65536, got '$base_port'"
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, got '$seed'"
 [[ $agents =~ ^[1-4]$ ]] || die "--offense-agents must be 1 to 4 (HFO's learned attackers per server), got '$agents'"
+((team_actor == 0 || agents > 1)) || die "--team-actor plays a team of --offense-agents M > 1 in one actor; give --offense-agents"
 if [[ ${security[0]:-} == --curve-keys ]]; then
   [[ -f ${security[1]}/client.keys ]] ||
     die "--curve-keys: no client.keys in '${security[1]}' (make the keys with pamdp keygen, and give the directory holding client.keys)"
@@ -96,7 +101,14 @@ run_pair() {
       --fullstate --no-logging --frames-per-trial 500 --port "$port" --seed $((seed + 100 * i + restart)) >"$log" 2>&1) &
     server=$!
     team=()
-    for ((k = 0; k < agents; k++)); do
+    # One actor per player, or one for the team (--team-actor: it joins its players itself).
+    local actors_here=$agents
+    local -a per_actor=()
+    if ((team_actor == 1)); then
+      actors_here=1
+      per_actor=(--server-agents "$agents")
+    fi
+    for ((k = 0; k < actors_here; k++)); do
       # HFO's trainer says it waits for an agent once per player slot; the k-th actor joins
       # after the k-th time (an agent that joins earlier breaks the server, docs/hfo-server.md).
       until (($(grep -c "Waiting for player-controlled agent" "$log" 2>/dev/null || true) > k)); do
@@ -106,13 +118,13 @@ run_pair() {
       done
       name=hfo-actor-$i
       alog=$log_dir/actor-$i.log
-      if ((agents > 1)); then
+      if ((actors_here > 1)); then
         name=hfo-actor-$i-$k
         alog=$log_dir/actor-$i-$k.log
       fi
       # No --seed: the actor seeds its exploration from the run's seed and its index, as in
       # deploy/local-cluster.sh; the server's --seed above decides the episodes' starts.
-      "$bin" actor --join "$join" --server-port "$port" --name "$name" "${security[@]}" >>"$alog" 2>&1 &
+      "$bin" actor --join "$join" --server-port "$port" --name "$name" "${per_actor[@]}" "${security[@]}" >>"$alog" 2>&1 &
       team+=($!)
     done
     if ((${#team[@]} > 0)); then
@@ -141,11 +153,15 @@ trap stop_all INT TERM EXIT
 for ((i = 0; i < actors; i++)); do
   run_pair "$i" &
   pairs+=($!)
-  if ((agents == 1)); then
+  if ((agents == 1 || team_actor == 1)); then
     echo "actor $i: HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i.log"
   else
     echo "team $i: $agents actors on the HFO server on port $((base_port + 10 * i)), logs $log_dir/hfo-$((base_port + 10 * i)).log and $log_dir/actor-$i-*.log"
   fi
 done
-echo "hfo-server-actors: $actors servers with $agents actors each joining $join; Ctrl-C stops them and their servers"
+if ((team_actor == 1)); then
+  echo "hfo-server-actors: $actors servers, each with one actor playing its $agents agents, joining $join; Ctrl-C stops them and their servers"
+else
+  echo "hfo-server-actors: $actors servers with $agents actors each joining $join; Ctrl-C stops them and their servers"
+fi
 wait

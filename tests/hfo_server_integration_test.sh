@@ -7,7 +7,9 @@
 #   3. kills a server under a running eval: pamdp exits non-zero naming SERVER_DOWN;
 #   4. asks for a server where none runs: pamdp exits non-zero within
 #      env.server_connect_timeout_s saying how to start one (with python3);
-#   5. starts an eval together with its server, not waiting for bin/HFO's line: the env waits.
+#   5. starts an eval together with its server, not waiting for bin/HFO's line: the env waits;
+#   6. plays a 2v1 team in one process (env.server_agents = 2): both agents of one server, in
+#      lockstep, the scripted team against agent2d's goalie.
 # Exits 77 (skipped) when no server can be started here: no Python with numpy (bin/HFO imports
 # it), no bin/HFO or rcssserver in HFO_ROOT, or the server never waits for its agent.
 #
@@ -68,13 +70,15 @@ for _ in range(500):
 EOF
 }
 
-# Starts a server in a process group of its own; sets $port.
+# Starts a server in a process group of its own; sets $port. START_SERVER_ARGS: bin/HFO's flags
+# beside the common ones (default: --offense-agents 1).
 start_server() {
   local seed=$1
+  local args=(${START_SERVER_ARGS:---offense-agents 1})
   port=$(free_port)
   [[ -n $port ]] || skip "no free port found"
   local log=$work/hfo-$port.log
-  setsid "$py" "$hfo_root/bin/HFO" --offense-agents 1 --headless --fullstate --no-logging --frames-per-trial 500 \
+  setsid "$py" "$hfo_root/bin/HFO" "${args[@]}" --headless --fullstate --no-logging --frames-per-trial 500 \
     --port "$port" --seed "$seed" >"$log" 2>&1 &
   groups+=($!)
   for _ in $(seq 1 300); do
@@ -156,4 +160,25 @@ groups+=($!)
   fail "pamdp eval started together with its server failed"
 }
 grep -q "answered after .* giving its trainer" "$work/early.err" || fail "the env did not see the server start"
+
+# 6. Two agents and agent2d's goalie, one process: the team env joins both, one after the other.
+START_SERVER_ARGS="--offense-agents 2 --defense-npcs 1" start_server 15
+out=$("$bin" eval --env hfo-server --set "env.server_port=$port" --policy scripted --offense-agents 2 --goalie \
+  --episodes 20 --json 2>"$work/team.err") || {
+  cat "$work/team.err" "$work/hfo-$port.log" >&2
+  fail "pamdp eval of a team on one server failed"
+}
+json=$(tail -n 1 <<<"$out")
+"$py" - "$json" <<'EOF' || fail "bad JSON from the team eval: $json"
+import json, sys
+r = json.loads(sys.argv[1])
+assert r["episodes"] == 20, r
+assert sum(r["outcomes"].values()) == 20, r
+assert r["goal_rate"] >= 0.6, r  # the scripted team scores .95 against the goalie on the real server
+EOF
+[[ $(grep -c "hfo-server: joined localhost:$port as unum" "$work/team.err") == 2 ]] || {
+  cat "$work/team.err" >&2
+  fail "the team env did not join two agents"
+}
+echo "a team of two on the real server: $json"
 echo "hfo-server integration: OK"

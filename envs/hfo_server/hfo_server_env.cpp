@@ -42,14 +42,17 @@ std::string address(const HfoServerConfig& c) {
 
 // HFO's client library calls exit(1) when it cannot start (it has no error return). While a
 // connection is being made, this says which server and what to do before the process ends.
-char g_connecting_to[512] = {};
+// Per thread: the players of one team env (LockstepTeamEnv) connect at once, each on its own.
+thread_local char g_connecting_to[512] = {};
 extern "C" void explain_exit_while_connecting() {
   if (g_connecting_to[0] != '\0') {
     std::fprintf(stderr,
                  "hfo-server: HFO's client library gave up connecting to %s (its message above). Connect only "
                  "after bin/HFO has printed 'Waiting for player-controlled agent' (an agent that joins earlier takes "
                  "an NPC's place, the trainer disconnects it and the game never starts), and to a server whose agent "
-                 "slot is free. That server cannot be used any more: stop its bin/HFO and start a fresh one.\n",
+                 "slot is free; the players of one process (env.server_agents > 1) join env.server_join_interval_ms "
+                 "apart, so on a busy machine raise it. That server cannot be used any more: stop its bin/HFO and "
+                 "start a fresh one.\n",
                  g_connecting_to);
   }
 }
@@ -152,6 +155,9 @@ class HfoServerEnv final : public Env {
                                "' is not a directory; point it at HFO's bin/teams/base/config/formations-dt");
     }
     wait_for_server(c_);
+    if (c_.join_delay_ms > 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(c_.join_delay_ms));
+    }
     static const bool registered = std::atexit(explain_exit_while_connecting) == 0;
     (void)registered;
     std::snprintf(g_connecting_to, sizeof(g_connecting_to), "%s", address(c_).c_str());

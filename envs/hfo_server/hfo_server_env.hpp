@@ -6,9 +6,10 @@
 //  - One env is one player of one running server (`bin/HFO --offense-agents 1 --fullstate
 //    --headless --port P`); the server must be started before the env's first reset() and
 //    ends when the env disconnects (HFO's trainer stops the game when its agent leaves). With
-//    --offense-agents N (env.offense_agents = N) each of N processes plays one of them, and the
-//    server, in synchronous mode, runs a cycle once every agent has acted: a team plays in
-//    lockstep by itself.
+//    --offense-agents N (env.offense_agents = N) each of N envs plays one of them, and the server,
+//    in synchronous mode, runs a cycle once every agent has acted: a team plays in lockstep by
+//    itself. The N envs are N processes, or one process's team env (env.server_agents = N:
+//    lockstep_team.hpp, each player on a thread of its own, joining join_delay_ms apart).
 //  - Connects lazily, on the first reset(): constructing one (to learn the observation size, as
 //    the learner and replay shards do) opens no socket. Connecting allocates; steps then do not,
 //    apart from what HFO's client library does inside.
@@ -29,8 +30,10 @@
 //  - Parameters outside the server's ranges are clipped or wrapped as HFO's client would
 //    (server_action.hpp) and counted: counters() gives kick_power_clamped, dash_power_clamped
 //    and direction_wrapped since construction.
-//  - Not thread-safe; one env per thread (HFO's client keeps process-wide parameter singletons,
-//    so one env per process is the tested case).
+//  - Not thread-safe; one env per thread. HFO's client keeps process-wide parameter singletons
+//    (librcsc's ServerParam, PlayerParam), which every player of a process sets to the server's
+//    same values; HFO's own example/thread_agents.cpp plays two agents of one process this way,
+//    and so does the team env (tested live: tests/hfo_server_integration_test.sh).
 #pragma once
 
 #include <memory>
@@ -60,6 +63,10 @@ struct HfoServerConfig {
   int max_steps = 500;         // the server's --frames-per-trial (500 for dqn-hfo); the env ends longer episodes
   int connect_timeout_s = 30;  // how long the first reset() waits for a server to answer (env.server_connect_timeout_s)
   bool shoot_action = false;   // the action space with SHOOT, a second kick (env.shoot_action, envs/hfo/hfo_env.hpp)
+  // How long the first reset() waits, once the server answers, before this player joins: player i
+  // of a team env joins i * env.server_join_interval_ms after player 0 (HFO's trainer takes its
+  // agents one at a time, in its own order of unums, launching agent2d NPCs for the slots between).
+  int join_delay_ms = 0;
 };
 
 // How long a server that came up while the first reset() waited is given to fill its NPC slots
