@@ -3,7 +3,8 @@
 // InterceptTable::predictSelf takes from it. Our own code; the rules and the constants are
 // librcsc's, named after the function they come from. The goalie never kicks in HFO, so the
 // last kicker is never its own side: the "goalie mode" (catchable area as the control area inside
-// its penalty area) depends on the ball's place only.
+// its penalty area) depends on the ball's place only. With SelfView::goalie false it is a field
+// player's (agent2d's field defenders): no goalie mode, and back dashes only within 4 cycles.
 #include <algorithm>
 #include <cmath>
 
@@ -100,8 +101,10 @@ class SelfIntercept {
  private:
   [[nodiscard]] double dash_rate() const { return w_.self.effort * kDashPowerRate; }
 
-  static double control_area_at(Vec2 ball, double x_line, double half_width) {
-    return (ball.x < x_line && std::fabs(ball.y) < half_width) ? kCatchableArea : kKickableArea;
+  // A goalie's control area is its catchable area inside its penalty area; a field player's is
+  // always its kickable area (SelfInterceptV13: self().goalie() and the last kicker's side).
+  [[nodiscard]] double control_area_at(Vec2 ball, double x_line, double half_width) const {
+    return (w_.self.goalie && ball.x < x_line && std::fabs(ball.y) < half_width) ? kCatchableArea : kKickableArea;
   }
 
   void push(const InterceptInfo& info) {
@@ -140,7 +143,8 @@ class SelfIntercept {
   bool predict_no_dash() {
     const Vec2 my_next = w_.self.pos + w_.self.vel;
     const Vec2 ball_next = w_.ball_pos + w_.ball_vel;
-    const bool goalie_mode = ball_next.x < kOurPenaltyLineX && std::fabs(ball_next.y) < kPenaltyBoxHalfWidth;
+    const bool goalie_mode =
+        w_.self.goalie && ball_next.x < kOurPenaltyLineX && std::fabs(ball_next.y) < kPenaltyBoxHalfWidth;
     const double control = goalie_mode ? kCatchableArea : kKickableArea;
     const Vec2 next_ball_rel = rotate_deg(ball_next - my_next, -w_.self.body_deg);
     const double ball_noise = w_.ball_vel.r() * w_.ball_rand;
@@ -598,7 +602,8 @@ class SelfIntercept {
   void predict_final(int max_cycle) {
     const Vec2 my_final = self_inertia_point(w_, 100);
     const Vec2 ball_final = ball_inertia_point(w_, 100);
-    const bool goalie_mode = ball_final.x < kOurPenaltyLineX && std::fabs(ball_final.y) < kPenaltyBoxHalfWidth;
+    const bool goalie_mode =
+        w_.self.goalie && ball_final.x < kOurPenaltyLineX && std::fabs(ball_final.y) < kPenaltyBoxHalfWidth;
     const double control = goalie_mode ? kCatchableArea - 0.15 : kKickableArea;
     double dash_angle = w_.self.body_deg;
     bool back_dash = false;
@@ -663,8 +668,8 @@ class SelfIntercept {
     if (angle_diff < kBackDashThrAngle) {
       return false;
     }
-    if (cycle >= 5) {  // a goalie while the opponents kicked last
-      if (cycle >= 15) {
+    if (cycle >= 5) {  // a goalie while the opponents kicked last; a field player never
+      if (!w_.self.goalie || cycle >= 15) {
         return false;
       }
       const Vec2 goal{-kPitchHalfLength, 0.0};

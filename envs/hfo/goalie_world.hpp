@@ -77,6 +77,9 @@ struct SelfView {
   double recovery = 1.0;
   double capacity = kStaminaCapacity;
   bool frozen = false;  // after its own tackle
+  // librcsc SelfObject::goalie(): false for a field player (agent2d's field defenders), whose
+  // control area in its own intercept is always the kickable area (goalie_self_intercept.cpp).
+  bool goalie = true;
 };
 
 // librcsc WorldModel, reduced to what the goalie reads, in the goalie's frame.
