@@ -1,12 +1,14 @@
 #!/usr/bin/python3
-"""Record team games (2v0, 2v1) on the real HFO server and turn its logs into per-cycle CSV.
+"""Record team games (2v0, 2v1, and against agent2d's field defenders: 1v2, 2v2, 1v3) on the
+real HFO server and turn its logs (and the defenders' own .dcl debug logs) into per-cycle CSV.
 
 Subcommands (see README.md next to this file):
 
   record  start bin/HFO (noise off, .rcg/.rcl logging on), drive its N offense-agent slots
           with random and scripted low-level policies, one process per agent
   agent   (internal) one HFO agent process, started by `record`
-  parse   read a recording's .rcg/.rcl and the agents' own step logs, write one row per cycle
+  parse   read a recording's .rcg/.rcl, the agents' own step logs and the defenders' .dcl
+          files, write one row per cycle
   subset  pick whole episodes from parsed recordings into a compact CSV for the tests
 
 Only the Python standard library and numpy are used.
@@ -101,6 +103,9 @@ class View:
         self.bvx, self.bvy = bs * math.cos(bth), bs * math.sin(bth)
         self.mates = [self._player(f, N_BASIC + PER_PLAYER * i) for i in range(n_team)]
         self.opps = [self._player(f, N_BASIC + PER_PLAYER * (n_team + i)) for i in range(n_opp)]
+        # after the blocks: one unum/100 per teammate, then one per opponent (-1: empty)
+        u0 = N_BASIC + PER_PLAYER * (n_team + n_opp) + n_team
+        self.opp_unums = [int(round(f[u0 + i] * 100)) for i in range(n_opp)]
 
     def _player(self, f, i):
         blk = f[i:i + PER_PLAYER]
@@ -205,6 +210,15 @@ def policy_contest(v, rng, state):
 def policy_team(v, rng, me_unum, mate_unum, state):
     mate = v.mates[0] if v.mates else None
     goalie = v.opps[0] if v.opps else None
+    # with field defenders (--defense-npcs >= 2): the goalie is the opponent with unum 1, and
+    # the nearest field defender also makes the player pass or dribble away
+    near = None
+    if len(v.opps) > 1:
+        gk = [o for o, u in zip(v.opps, v.opp_unums) if o is not None and u == 1]
+        goalie = gk[0] if gk else goalie
+        field = [o for o, u in zip(v.opps, v.opp_unums) if o is not None and u != 1]
+        near = min(field, key=lambda o: v.dist(*o)) if field else None
+    near_d = v.dist(*near) if near is not None else 99.0
     my_n, _, _ = intercept(v, v.x, v.y)
     owner = True
     if mate is not None:
@@ -231,7 +245,7 @@ def policy_team(v, rng, me_unum, mate_unum, state):
             mate_ok = mate[0] > v.x - 4.0 and 4.0 < v.dist(*mate) < 30.0
             if goalie is not None:
                 mate_ok = mate_ok and math.hypot(mate[0] - goalie[0], mate[1] - goalie[1]) > gk_d
-            if mate_ok and (gclose or rng.random() < state['pass_p']):
+            if mate_ok and (gclose or near_d < 5.0 or rng.random() < state['pass_p']):
                 lead = min(2.0, max(0.0, HALF_L - 3.0 - mate[0]))
                 tx, ty = mate[0] + lead, mate[1]
                 return kick_to(v, tx, ty, pass_power(v.dist(tx, ty)))
@@ -239,6 +253,8 @@ def policy_team(v, rng, me_unum, mate_unum, state):
         ty = state['dribble_y']
         if goalie is not None and gk_d < 15.0:
             ty = 12.0 if goalie[1] < v.y else -12.0
+        elif near is not None and near_d < 10.0:
+            ty = 12.0 if near[1] < v.y else -12.0
         return kick_to(v, min(HALF_L, v.x + 10.0), ty, state['dribble_power'])
     # support: get ahead of the ball, on the other side
     side = 1.0 if v.by < 0 else -1.0
@@ -351,20 +367,60 @@ def new_episode_state(rng):
 # record: the server plus N agent processes
 
 LAUNCHER = r'''
-import os, sys
+import os, sys, types
 src_path = sys.argv[1]
 extra = os.environ['HFO_RECORD_EXTRA_OPTIONS']
 src = open(src_path).read()
 hook = "  if args.deterministic:"
 assert src.count(hook) == 1, "bin/HFO changed: cannot add server options"
 src = src.replace(hook, "  serverOptions += ' ' + %r\n" % extra + hook)
+bin_dir = os.path.dirname(os.path.realpath(src_path))
+dcl_unums = os.environ.get('HFO_RECORD_DCL_UNUMS', '').split()
+if dcl_unums:
+    # bin/Teams.py, Agent2d.launch_npc: give the defense NPCs listed agent2d's player option
+    # --debug_server_logging (librcsc PlayerConfig; each writes LOG_DIR/base_right-UNUM.dcl).
+    # The module is built here from Teams.py's source with one line added, and put into
+    # sys.modules before bin/HFO's Trainer imports it; the file itself is not touched.
+    t_path = os.path.join(bin_dir, 'Teams.py')
+    t_src = open(t_path).read()
+    i = t_src.index('class Agent2d(Team):')
+    j = t_src.find('\nclass ', i)
+    j = len(t_src) if j < 0 else j
+    seg = t_src[i:j]
+    t_hook = "    return self.start_npc_proc(launchOpts)\n"
+    assert seg.count(t_hook) == 1 and "print('Launch npc %s-%d' % (self._name, player_num))" \
+        in seg, "bin/Teams.py changed: cannot add --debug_server_logging"
+    add = ("    if self._name == 'base_right' and player_num in %r:\n"
+           "      launchOpts = ((launchOpts or '') + ' --debug_server_logging').strip()\n"
+           % (tuple(int(u) for u in dcl_unums),))
+    t_src = t_src[:i] + seg.replace(t_hook, add + t_hook) + t_src[j:]
+    teams = types.ModuleType('Teams')
+    teams.__file__ = t_path
+    exec(compile(t_src, t_path, 'exec'), teams.__dict__)
+    sys.modules['Teams'] = teams
 sys.argv = [src_path] + sys.argv[2:]
-sys.path.insert(0, os.path.dirname(os.path.realpath(src_path)))
+sys.path.insert(0, bin_dir)
 exec(compile(src, src_path, 'exec'), {'__name__': '__main__', '__file__': src_path})
 '''
 
+# bin/Teams.py, Agent2d.__init__: defenseOrder = [2,3,4,5,6,7,8,11,9,10]; bin/Trainer.py,
+# Trainer.getTeams puts 1 (the goalie) in front, and Trainer.run keeps
+# defense_unums = sorted(_defenseOrder[:numDefense]): K defense NPCs are unums 1..K (K <= 7)
+DEFENSE_ORDER = [1, 2, 3, 4, 5, 6, 7, 8, 11, 9, 10]
+
+
+def defense_unums(k):
+    return sorted(DEFENSE_ORDER[:k])
+
 
 def cmd_record(a):
+    if a.goalie:
+        if a.defense_npcs not in (None, 1):
+            raise SystemExit('--goalie is --defense-npcs 1')
+        a.defense_npcs = 1
+    k_def = a.defense_npcs or 0
+    if not 0 <= k_def <= 3:
+        raise SystemExit('--defense-npcs must be 0..3')
     out = os.path.abspath(a.out)
     os.makedirs(os.path.join(out, 'log'), exist_ok=True)
     hfo_bin = os.path.join(a.hfo, 'bin', 'HFO')
@@ -372,12 +428,16 @@ def cmd_record(a):
              '--frames-per-trial', str(a.frames_per_trial), '--seed', str(a.seed),
              '--port', str(a.port), '--log-dir', os.path.join(out, 'log'),
              '--trials', str(a.episodes)]
-    if a.goalie:
-        hargs += ['--defense-npcs', '1']
-    env = dict(os.environ, HFO_RECORD_EXTRA_OPTIONS=NOISE_OFF, PYTHONUNBUFFERED='1')
+    if k_def:
+        hargs += ['--defense-npcs', str(k_def)]
+    dcl = defense_unums(k_def) if a.debug_logs else []
+    env = dict(os.environ, HFO_RECORD_EXTRA_OPTIONS=NOISE_OFF, PYTHONUNBUFFERED='1',
+               HFO_RECORD_DCL_UNUMS=' '.join(str(u) for u in dcl))
     cmd = [sys.executable, '-u', '-c', LAUNCHER, hfo_bin] + hargs
     meta = {'hfo': a.hfo, 'args': hargs, 'extra_server_options': NOISE_OFF,
-            'seed': a.seed, 'mix': a.mix, 'agents': a.agents, 'goalie': a.goalie,
+            'seed': a.seed, 'mix': a.mix, 'agents': a.agents, 'goalie': k_def >= 1,
+            'defense_npcs': k_def, 'defense_unums': defense_unums(k_def),
+            'debug_server_logging_unums': dcl,
             'started': time.strftime('%Y-%m-%d %H:%M:%S')}
     with open(os.path.join(out, 'meta.json'), 'w') as fh:
         json.dump(meta, fh, indent=1)
@@ -489,6 +549,60 @@ def parse_rcl(path):
             if msg.startswith('(referee '):
                 referee.setdefault(t, []).append(msg[len('(referee '):-1])
     return cmds, referee
+
+
+DCL_TIME_RE = re.compile(r'\(time (\d+)\)')
+DCL_SELF_RE = re.compile(r'\(s ([lr]) (\d+) (\S+) (\S+) (\S+) (\S+) (\S+) (\S+) ')
+DCL_BALL_RE = re.compile(r'\(b (\S+) (\S+)(?: (\S+) (\S+))? \(c "g(\d+)r(\d+)v(\d+)"\)\)')
+DCL_TARGET_RE = re.compile(r'\(target-point (\S+) (\S+)\)')
+DCL_MSG_RE = re.compile(r'\(message "([^"]*)"\)')
+# parts of the .dcl message that name neck, view and attention actions, not the body's
+# decision (agent2d: NeckScan…, NeckBall…, OffenseNeck…, InterceptNeck, IN:Default…,
+# ViewNormal, AttCurSender…, AttBallNearest…, AttOff…)
+DCL_NOT_BODY = ('Neck', 'OffenseNeck', 'InterceptNeck', 'IN:', 'View', 'Att')
+
+
+def dcl_label(msg):
+    parts = [x for x in msg.split('/') if x]
+    return '/'.join(x for x in parts if not x.startswith(DCL_NOT_BODY))
+
+
+def parse_dcl(path):
+    """agent2d's --debug_server_logging file (librcsc DebugClient::toStr/write, format
+    version 3): time -> what the player's world model held when it decided in that cycle.
+    Coordinates in a .dcl are in the player's own frame (a right-side player has its goal at
+    x = -52.5), here turned into the global frame of the .rcg. Returns (entries, duplicates)."""
+    out, dup = {}, 0
+    with open(path, errors='replace') as fh:
+        for line in fh:
+            if not line.startswith('%% debug ['):
+                continue
+            m = DCL_TIME_RE.search(line)
+            if not m:
+                continue
+            t = int(m.group(1))
+            e = {}
+            sm = DCL_SELF_RE.search(line)
+            sg = -1.0 if (sm and sm.group(1) == 'r') else 1.0
+            if sm:
+                x, y, vx, vy, body = (float(sm.group(i)) for i in range(3, 8))
+                e['self'] = (sg * x, sg * y, sg * vx, sg * vy,
+                             wrap(body + (180.0 if sg < 0 else 0.0)))
+            bm = DCL_BALL_RE.search(line)
+            if bm:
+                e['ball'] = (sg * float(bm.group(1)), sg * float(bm.group(2)))
+                e['bvel'] = None if bm.group(3) is None else \
+                    (sg * float(bm.group(3)), sg * float(bm.group(4)))
+                e['bcount'] = (int(bm.group(5)), int(bm.group(7)))   # pos count, vel count
+            tm = DCL_TARGET_RE.search(line)
+            if tm:
+                e['target'] = (sg * float(tm.group(1)), sg * float(tm.group(2)))
+            mm = DCL_MSG_RE.search(line)
+            e['msg'] = mm.group(1) if mm else ''
+            if t in out:
+                dup += 1
+            out[t] = e
+    return out, dup
 
 
 def status_of(events):
@@ -617,6 +731,20 @@ def cmd_parse(a):
     if goalie:
         players.append(('g', ('r', 1)))
     nfs = [agents[k]['features'].shape[1] for k in range(len(agents))]
+    # every defense NPC, goalie included, by uniform number: d0 = unum 1 (the goalie, also
+    # `g`), d1 = unum 2, d2 = unum 3; with their .dcl where the recording has one
+    n_def = meta.get('defense_npcs', 1 if goalie else 0)
+    defenders = [('d%d' % i, ('r', u))
+                 for i, u in enumerate(meta.get('defense_unums', defense_unums(n_def)))]
+    dcls = {}
+    for name, key in defenders:
+        path = os.path.join(run, 'log', 'base_right-%d.dcl' % key[1])
+        if os.path.exists(path):
+            dcls[name], dup = parse_dcl(path)
+            print('%s (unum %d): %d .dcl entries, %d cycles with more than one'
+                  % (name, key[1], len(dcls[name]), dup))
+    # players whose step outcomes go into `tags`: the agents, the goalie, field defenders
+    tagged = players + [d for d in defenders if d[1] != ('r', 1)]
 
     header = ['src', 'ep', 't', 'cycle', 'status', 'tags', 'bx', 'by', 'bvx', 'bvy']
     for name, _ in players:
@@ -627,6 +755,10 @@ def cmd_parse(a):
             header += [name + '_req', name + '_r1', name + '_r2']
     for k in range(len(agents)):
         header += ['f%d_%d' % (k, j) for j in range(nfs[k])]
+    for name, _ in defenders:
+        header += [name + s for s in ('_x', '_y', '_vx', '_vy', '_body', '_stamina', '_state',
+                                      '_cmd', '_c1', '_c2', '_label', '_tx', '_ty',
+                                      '_wbx', '_wby', '_wbvx', '_wbvy', '_wbpc', '_wbvc')]
 
     tackle_cycles = 10
     with open(rcgs[0], errors='replace') as fh:
@@ -636,7 +768,7 @@ def cmd_parse(a):
                 tackle_cycles = int(m.group(1))
                 break
     tackles = {key: sorted(T for (T, sd, un), c in cmds.items()
-                           if (sd, un) == key and c[0][0] == 'tackle') for _, key in players}
+                           if (sd, un) == key and c[0][0] == 'tackle') for _, key in tagged}
     stats = {'episodes': 0, 'cycles': 0, 'statuses': {}, 'pcoll_cycles': 0,
              'bcoll_cycles': 0, 'double_kick_cycles': 0, 'double_kick_cmd_cycles': 0,
              'kicks': 0, 'tackles': 0, 'rows_with_features': [0] * len(agents)}
@@ -652,7 +784,7 @@ def cmd_parse(a):
         # flags in the next show: what happened in the step T -> T+1
         kicks_ok, kick_cmds = 0, 0
         if nxt is not None and status[T] == 'IN_GAME':
-            for name, key in players:
+            for name, key in tagged:
                 if key in nxt[1]:
                     s = nxt[1][key][8]
                     if s & 0x800:
@@ -662,7 +794,7 @@ def cmd_parse(a):
                     if s & 0x10000:
                         tags.append(name + ':post')
         if nxt is not None:
-            for name, key in players:
+            for name, key in tagged:
                 c = cmds.get((T,) + key, [])
                 if not c or key not in nxt[1]:
                     continue
@@ -673,7 +805,7 @@ def cmd_parse(a):
                     tags.append(name + (':tackle_fault' if s & 0x2000 else ':tackle_ok'))
                 if len(c) > 1:
                     tags.append(name + ':multicmd')
-        for name, key in players:
+        for name, key in tagged:
             c = cmds.get((T,) + key, [])
             if c and c[0][0] == 'kick':
                 kick_cmds += 1
@@ -718,6 +850,28 @@ def cmd_parse(a):
             else:
                 stats['rows_with_features'][k] += 1
                 row += [fmt(float(x)) for x in agents[k]['features'][i]]
+        for name, key in defenders:
+            p = pl.get(key)
+            if p is None:
+                row += [''] * 7
+            else:
+                row += [fmt(x) for x in p[:6]] + ['0x%x' % p[8]]
+            c = cmds.get((T,) + key, [])
+            if c:
+                # as logged; a foul tackle is (tackle DIR on): c2 = 'on'
+                row += [c[0][0].upper()] + (c[0][1:] + ['', ''])[:2]
+            else:
+                row += ['NONE', '', '']
+            e = dcls.get(name, {}).get(T)
+            if e is None:
+                row += [''] * 9
+            else:
+                row.append(dcl_label(e['msg']))
+                row += [fmt(x) for x in e['target']] if 'target' in e else ['', '']
+                row += [fmt(x) for x in e['ball']] if 'ball' in e else ['', '']
+                row += [fmt(x) for x in e['bvel']] if e.get('bvel') else ['', '']
+                row += [str(x) for x in e['bcount']] if 'bcount' in e else ['', '']
+            defense_stats(stats, name, key, T, p, c, e, ball, status[T])
         rows.append(row)
         eps_written.add(ep_of[T])
         stats['cycles'] += 1
@@ -738,6 +892,8 @@ def cmd_parse(a):
             if c and c[0][0] == 'tackle':
                 stats['tackles'] += 1
     stats['episodes'] = len(eps_written)
+    if defenders:
+        defense_stats_done(stats)
     with open(a.out, 'w', newline='') as fh:
         w = csv.writer(fh, lineterminator='\n')
         w.writerow(header)
@@ -747,6 +903,55 @@ def cmd_parse(a):
     if a.stats:
         with open(a.stats, 'w') as fh:
             json.dump(stats, fh, indent=1)
+
+
+def defense_stats(stats, name, key, T, p, c, e, ball, status):
+    """Per defender: body command kinds, decision labels, and how far its world model (.dcl)
+    is from the .rcg's truth in the same cycle. The .dcl rounds to 0.01 (DebugClient::toStr),
+    so a difference above 0.011 is a real one."""
+    d = stats.setdefault('defenders', {}).setdefault(name, {
+        'unum': key[1], 'rows': 0, 'cmd': {}, 'labels': {}, 'rows_with_dcl': 0,
+        'self_pos_err_max': 0.0, 'ball_pos_err_max': 0.0, 'ball_pos_off': 0,
+        'ball_vel_known': 0, 'ball_vel_off': 0, 'ball_vel_off_zero': 0,
+        'ball_vel_err_max': 0.0, 'ball_vel_off_ball_moving': 0, 'ball_moving': 0,
+        'foul_tackles': 0})
+    if p is None:
+        return
+    d['rows'] += 1
+    kind = c[0][0].upper() if c else 'NONE'
+    d['cmd'][kind] = d['cmd'].get(kind, 0) + 1
+    if c and c[0][0] == 'tackle' and c[0][2:3] == ['on']:
+        d['foul_tackles'] += 1
+    if e is None:
+        return
+    d['rows_with_dcl'] += 1
+    lab = re.sub(r'[-0-9.:|()]+.*$', '', dcl_label(e['msg']).split('/')[0]) or '(none)'
+    d['labels'][lab] = d['labels'].get(lab, 0) + 1
+    if 'self' in e:
+        d['self_pos_err_max'] = max(d['self_pos_err_max'],
+                                    math.hypot(e['self'][0] - p[0], e['self'][1] - p[1]))
+    if 'ball' in e:
+        err = math.hypot(e['ball'][0] - ball[0], e['ball'][1] - ball[1])
+        d['ball_pos_err_max'] = max(d['ball_pos_err_max'], err)
+        d['ball_pos_off'] += err > 0.011 * math.sqrt(2)
+    moving = math.hypot(ball[2], ball[3]) > 0.011
+    d['ball_moving'] += moving
+    if e.get('bvel'):
+        d['ball_vel_known'] += 1
+        err = math.hypot(e['bvel'][0] - ball[2], e['bvel'][1] - ball[3])
+        d['ball_vel_err_max'] = max(d['ball_vel_err_max'], err)
+        if err > 0.011 * math.sqrt(2):
+            d['ball_vel_off'] += 1
+            d['ball_vel_off_ball_moving'] += moving
+            d['ball_vel_off_zero'] += e['bvel'] == (0.0, 0.0) or e['bvel'] == (-0.0, -0.0)
+
+
+def defense_stats_done(stats):
+    for d in stats.get('defenders', {}).values():
+        n = max(1, d['rows'])
+        d['cmd_fraction'] = {k: round(v / n, 4) for k, v in sorted(d['cmd'].items())}
+        d['ball_vel_off_fraction'] = round(d['ball_vel_off'] / max(1, d['ball_vel_known']), 4)
+        d['labels'] = dict(sorted(d['labels'].items(), key=lambda kv: -kv[1]))
 
 
 # ----------------------------------------------------------------------------------------
@@ -784,6 +989,20 @@ def cmd_subset(a):
     groups = [(0.2, has_tag('kick2')), (0.15, has_tag('pcoll')), (0.05, has_tag('tackle_ok')),
               (0.05, hidden_mate), (0.2, ends('GOAL')), (0.15, ends('CAPTURED_BY_DEFENSE')),
               (0.1, ends('OUT_OF_BOUNDS')), (0.1, ends('OUT_OF_TIME'))]
+    # files with field defenders (d1_…): first the episodes where one kicks or tackles, or
+    # believes a stale ball velocity, then the groups above
+    dcols = [(header.index(h), header.index(h[:-4] + '_wbvx'))
+             for h in header if re.fullmatch(r'd[1-9]_cmd', h)]
+    if dcols:
+        bvx, bvy = header.index('bvx'), header.index('bvy')
+
+        def d_cmd(kind):
+            return lambda rows: any(r[i] == kind for r in rows for i, _ in dcols)
+
+        def stale(rows):
+            return any(r[j] != '' and abs(float(r[j]) - float(r[bvx])) +
+                       abs(float(r[j + 1]) - float(r[bvy])) > 0.1 for r in rows for _, j in dcols)
+        groups = [(0.1, d_cmd('TACKLE')), (0.1, d_cmd('KICK')), (0.1, stale)] + groups
     keys = sorted(eps)
     rng.shuffle(keys)
     chosen, size = [], 0
@@ -821,7 +1040,12 @@ def main():
     r.add_argument('--hfo', default='/work/hfo-ext/HFO', help='HFO source/build root')
     r.add_argument('--out', required=True, help='recording folder (logs, agent step logs)')
     r.add_argument('--agents', type=int, default=2)
-    r.add_argument('--goalie', action='store_true', help='--defense-npcs 1 (agent2d goalie)')
+    r.add_argument('--defense-npcs', type=int, default=None,
+                   help='agent2d defense NPCs, 0..3 (1: the goalie alone, 2: + one field '
+                        'defender, 3: + two)')
+    r.add_argument('--goalie', action='store_true', help='alias of --defense-npcs 1')
+    r.add_argument('--no-debug-logs', dest='debug_logs', action='store_false',
+                   help='do not give the defense NPCs --debug_server_logging (.dcl files)')
     r.add_argument('--episodes', type=int, default=100, help='HFO --trials')
     r.add_argument('--seed', type=int, default=1, help='server seed (also seeds the policies)')
     r.add_argument('--port', type=int, default=7100)
