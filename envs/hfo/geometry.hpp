@@ -132,6 +132,7 @@ inline constexpr double kTackleDist = 2.0;
 inline constexpr double kTackleBackDist = 0.0;
 inline constexpr double kTackleWidth = 1.25;
 inline constexpr double kTackleExponent = 6.0;
+inline constexpr double kFoulExponent = 10.0;  // rcssserver serverparam.cpp FOUL_EXPONENT
 inline constexpr int kTackleCycles = 10;
 inline constexpr double kTacklePowerRate = 0.027;
 inline constexpr double kMaxTacklePower = 100.0;

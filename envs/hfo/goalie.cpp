@@ -294,7 +294,7 @@ void basic_move(const Context& c) {
 // SelfObject's tackle probability (librcsc self_object.cpp, updateBallInfo): the server's
 // tackle failure (ball in the body frame against tackle_dist, tackle_back_dist, tackle_width,
 // tackle_exponent).
-double tackle_probability(const GoalieWorld& w) {
+double tackle_probability(const GoalieWorld& w, double exponent = kTackleExponent) {
   const double a = (w.self.body_deg) * kDegToRad;
   const Vec2 d = w.ball_pos - w.self.pos;
   const double x = d.x * std::cos(a) + d.y * std::sin(a);
@@ -303,8 +303,7 @@ double tackle_probability(const GoalieWorld& w) {
   if (dist <= 0.0) {
     return 0.0;
   }
-  const double fail =
-      std::pow(std::fabs(x) / dist, kTackleExponent) + std::pow(std::fabs(y) / kTackleWidth, kTackleExponent);
+  const double fail = std::pow(std::fabs(x) / dist, exponent) + std::pow(std::fabs(y) / kTackleWidth, exponent);
   return fail >= 1.0 ? 0.0 : std::max(0.0, 1.0 - fail);
 }
 
@@ -719,6 +718,14 @@ bool in_catch_area(Vec2 p) {
 }
 
 }  // namespace
+
+double tackle_success_probability(const agent2d::GoalieWorld& w, bool foul) {
+  return tackle_probability(w, foul ? kFoulExponent : kTackleExponent);
+}
+
+double tackle_generator_angle(const agent2d::GoalieWorld& w) {
+  return best_tackle_angle(w);
+}
 
 agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_noise) {
   // rcssserver sends the right side every position mirrored through the centre.

@@ -44,6 +44,15 @@ agent2d::GoalieWorld goalie_world(const SoccerState& state, int goalie, bool ser
 // The goalie's command for this cycle; `goalie` indexes state.players.
 GoalieCommand decide_goalie(const SoccerState& state, int goalie, bool server_noise);
 
+// SelfObject::tackleProbability (foul false) or foulProbability (foul true): the server's
+// tackle failure with tackle_exponent 6 or foul_exponent 10 (rcssserver serverparam.cpp).
+// Shared with the field defenders (defender.hpp).
+double tackle_success_probability(const agent2d::GoalieWorld& w, bool foul);
+
+// TackleGenerator::bestResult's tackle angle (global, in the player's frame; HFO
+// src/chain_action/tackle_generator.cpp). Shared with the field defenders.
+double tackle_generator_angle(const agent2d::GoalieWorld& w);
+
 // The command's name as the server's log writes it (DASH, TURN, CATCH, KICK, TACKLE, NONE).
 const char* goalie_command_name(GoalieCommand::Kind kind);
 

@@ -67,15 +67,16 @@ void GoalieWorld::finish() {
   // WorldModel::updatePlayerStateCache / check_player_kickable: only the opponent nearest to
   // the ball counts; it is kickable within kickable_area + an error that grows with the
   // distances from the goalie (ball: 2 %, player: 2 %, each at most 0.25).
-  exist_kickable_opponent = false;
-  if (num_opponents > 0) {
-    const PlayerView& o = opponents[0];
-    if (!o.tackling) {
-      const double ball_error = std::min(0.25, ball_dist_from_self * 0.02);
-      const double player_error = std::min(0.25, (o.pos - self.pos).r() * 0.02);
-      exist_kickable_opponent = (o.pos - ball_pos).r() < kKickableArea + ball_error + player_error;
+  const auto kickable = [&](const PlayerView& p) {
+    if (p.tackling) {
+      return false;
     }
-  }
+    const double ball_error = std::min(0.25, ball_dist_from_self * 0.02);
+    const double player_error = std::min(0.25, (p.pos - self.pos).r() * 0.02);
+    return (p.pos - ball_pos).r() < kKickableArea + ball_error + player_error;
+  };
+  exist_kickable_opponent = num_opponents > 0 && kickable(opponents[0]);
+  exist_kickable_teammate = num_teammates > 0 && kickable(teammates[0]);
 }
 
 Command do_dash(const GoalieWorld& w, double power, double dir_deg) {

@@ -86,10 +86,10 @@ bool can_reach_after_dash(const PlayerView& p, int n_turn, int max_dash, double 
 int predict_final(const GoalieWorld& w, const InterceptTable& t, const PlayerView& p) {
   const Vec2 ball_pos = t.ball_cache[static_cast<size_t>(t.ball_cache_size - 1)];
   const int ball_step = t.ball_cache_size;
-  const double control_area = kKickableArea;  // an attacker is no goalie
+  const double control_area = kKickableArea;  // PlayerIntercept::predictFinal: the kickable area
   const int n_turn = predict_turn_cycle(p, 100, control_area, ball_pos);
   double dash_dist = (inertia_point(p.pos, p.vel, 100) - ball_pos).r() - control_area;
-  dash_dist -= (p.pos - w.self.pos).r() * 0.03;  // an opponent's distance from the goalie
+  dash_dist -= (p.pos - w.self.pos).r() * 0.03;  // the player's distance from self
   if (dash_dist < 0.0) {
     return ball_step;
   }
@@ -97,8 +97,9 @@ int predict_final(const GoalieWorld& w, const InterceptTable& t, const PlayerVie
   return std::max(ball_step, n_turn + n_dash);
 }
 
-// PlayerIntercept::predict for an opponent with full state.
-int predict_opponent(const GoalieWorld& w, const InterceptTable& t, const PlayerView& p) {
+// PlayerIntercept::predict for a player with full state (an opponent, or a field defender's
+// teammate).
+int predict_player(const GoalieWorld& w, const InterceptTable& t, const PlayerView& p) {
   Vec2 ball_to_player = p.pos - w.ball_pos;
   { ball_to_player = rotate_deg(ball_to_player, -th_deg(w.ball_vel)); }
   int min_cycle = static_cast<int>(std::floor(std::fabs(ball_to_player.y) / kRealSpeedMax));
@@ -106,9 +107,14 @@ int predict_opponent(const GoalieWorld& w, const InterceptTable& t, const Player
     min_cycle += std::max(0, kTackleCycles - 2);
   }
   min_cycle = std::max(0, min_cycle);
-  const double control_area = kKickableArea;
   for (int cycle = min_cycle; cycle < t.ball_cache_size; ++cycle) {
     const Vec2 ball_pos = t.ball_cache[static_cast<size_t>(cycle)];
+    // A goalie (a field defender's teammate) controls the ball in its catchable area inside
+    // either penalty area (PlayerIntercept::predict).
+    const double control_area =
+        (p.goalie && std::fabs(ball_pos.x) > kPitchHalfLength - 16.5 && std::fabs(ball_pos.y) < kPenaltyBoxHalfWidth)
+            ? kCatchableArea
+            : kKickableArea;
     if (control_area + kRealSpeedMax * cycle + 0.5 < (p.pos - ball_pos).r()) {
       continue;
     }
@@ -157,6 +163,7 @@ void predict_ball_and_opponents(const GoalieWorld& w, InterceptTable* t) {
   t->self_exhaust_reach_cycle = 1000;
   t->opponent_reach_cycle = 1000;
   t->teammate_reach_cycle = 1000;
+  t->goalie_reach_cycle = 1000;
   t->self_predicted = false;
   create_ball_cache(w, t);
   // InterceptTable::predictOpponent: 0 with a kickable opponent, else the fastest one.
@@ -164,7 +171,21 @@ void predict_ball_and_opponents(const GoalieWorld& w, InterceptTable* t) {
     t->opponent_reach_cycle = 0;
   } else {
     for (int i = 0; i < w.num_opponents; ++i) {
-      t->opponent_reach_cycle = std::min(t->opponent_reach_cycle, predict_opponent(w, *t, w.opponents[i]));
+      t->opponent_reach_cycle = std::min(t->opponent_reach_cycle, predict_player(w, *t, w.opponents[i]));
+    }
+  }
+  // InterceptTable::predictTeammate: 0 with a kickable teammate, else the fastest one but the
+  // goalie, whose cycle librcsc keeps apart (goalieReachCycle).
+  if (w.exist_kickable_teammate) {
+    t->teammate_reach_cycle = 0;
+  } else {
+    for (int i = 0; i < w.num_teammates; ++i) {
+      const int cycle = predict_player(w, *t, w.teammates[i]);
+      if (w.teammates[i].goalie) {
+        t->goalie_reach_cycle = cycle;
+      } else {
+        t->teammate_reach_cycle = std::min(t->teammate_reach_cycle, cycle);
+      }
     }
   }
 }
@@ -216,7 +237,8 @@ const InterceptInfo* best_intercept(const GoalieWorld& w, const InterceptTable& 
     if (std::fabs(ball_pos.x) > max_pitch_x || std::fabs(ball_pos.y) > max_pitch_y) {
       continue;
     }
-    if (ball_pos.x < penalty_x - 1.0 && std::fabs(ball_pos.y) < penalty_y - 1.0 && cycle < opp_min - 1) {
+    if (w.self.goalie && ball_pos.x < penalty_x - 1.0 && std::fabs(ball_pos.y) < penalty_y - 1.0 &&
+        cycle < opp_min - 1) {
       if ((c.turn_cycle == 0 && c.ball_dist < kCatchableArea * 0.5) || c.ball_dist < 0.01) {
         const double d = (ball_pos - our_goal_pos).r2();
         if (d > goalie_score) {
@@ -225,7 +247,7 @@ const InterceptInfo* best_intercept(const GoalieWorld& w, const InterceptTable& 
         }
       }
     }
-    if (cycle < mate_min - 3 && cycle < opp_min - 5 &&
+    if (w.self.goalie && cycle < mate_min - 3 && cycle < opp_min - 5 &&
         (ball_pos.x > penalty_x - 1.0 || std::fabs(ball_pos.y) > penalty_y - 1.0)) {
       if ((c.turn_cycle == 0 && c.ball_dist < kKickableArea * 0.5) || c.ball_dist < 0.01) {
         if (ball_pos.x > goalie_aggressive_score) {
@@ -403,7 +425,28 @@ bool inertia_dash(const GoalieWorld& w, Vec2 target_point, const InterceptInfo& 
     *out = do_dash(w, info.dash_power, info.dash_angle_deg);
     return true;
   }
-  const Vec2 target_rel = rotate_deg(target_point - w.self.pos, -w.self.body_deg);
+  Vec2 target_rel = rotate_deg(target_point - w.self.pos, -w.self.body_deg);
+  if (!w.self.goalie && std::fabs(w.self.body_deg) < 50.0) {
+    // A field player facing the opponents' side stops slightly short of the ball (the goalie,
+    // whose opponents kicked last, never does).
+    const Vec2 ball_vel = w.ball_vel * ball_decay_pow(info.reach_cycle());
+    const int n = info.reach_cycle();
+    double buf = 0.3;
+    if (n >= 8) {
+      buf = 0.0;
+    } else if (std::fabs(target_rel.y) > kKickableArea - 0.25) {
+      buf = 0.0;
+    } else if (target_rel.x < 0.0 || target_rel.x < 0.3) {
+      buf = n >= 3 ? 0.5 : buf;
+    } else if (std::fabs(target_rel.y) < 0.5) {
+      buf = n >= 3 ? 0.5 : (n == 2 ? std::min(target_rel.x, 0.5) : buf);
+    } else if (ball_vel.r() < 1.6) {
+      buf = 0.4;
+    } else if (n == 2) {
+      buf = std::min(target_rel.x, 0.3);
+    }
+    target_rel.x -= buf;
+  }
   double used_power = info.dash_power;
   const double dash_rate = w.self.effort * kDashPowerRate;
   if (w.ball_vel.r() * ball_decay_pow(info.reach_cycle()) < kKickableArea * 1.5 &&

@@ -65,6 +65,7 @@ struct PlayerView {
   Vec2 vel;
   double body_deg = 0.0;
   bool tackling = false;  // frozen after a tackle (librcsc isTackling)
+  bool goalie = false;    // a field defender's teammate the goalie (its catchable area counts)
 };
 
 // The goalie's own state (librcsc SelfObject with full state).
@@ -91,6 +92,11 @@ struct GoalieWorld {
   // Opponents sorted by distance to the ball (WorldModel::opponentsFromBall).
   std::array<PlayerView, kMaxOpponents> opponents{};
   int num_opponents = 0;
+  // Teammates sorted by distance to the ball (a field defender's: the goalie and the other
+  // field defenders; none for the goalie, which ignores its field teammates here).
+  static constexpr int kMaxTeammates = 3;
+  std::array<PlayerView, kMaxTeammates> teammates{};
+  int num_teammates = 0;
   // Cycles since the goalie's last catch command; a large value when it has not caught.
   int since_catch = 1000;
   // WorldModel::gameMode() is GoalieCatch_ of its own side. A successful catch makes the
@@ -108,6 +114,7 @@ struct GoalieWorld {
   double ball_dist_from_self = 0.0;
   double ball_angle_from_self_deg = 0.0;  // global direction of the ball from the goalie
   bool exist_kickable_opponent = false;   // WorldModel::existKickableOpponent()
+  bool exist_kickable_teammate = false;   // WorldModel::existKickableTeammate()
   bool self_kickable = false;             // SelfObject::isKickable() (full state: buffer 0.055)
 
   void finish();
@@ -139,7 +146,8 @@ struct InterceptTable {
   int self_reach_cycle = 1000;
   int self_exhaust_reach_cycle = 1000;
   int opponent_reach_cycle = 1000;
-  int teammate_reach_cycle = 1000;  // HFO's defense has no field players here: always 1000
+  int teammate_reach_cycle = 1000;  // the field teammates' (the goalie's is goalie_reach_cycle)
+  int goalie_reach_cycle = 1000;    // a field defender's goalie teammate's (InterceptTable::goalieReachCycle)
   bool self_predicted = false;      // predict_self() has filled the self_* members
 };
 

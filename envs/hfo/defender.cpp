@@ -1,0 +1,207 @@
+#include "envs/hfo/defender.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "envs/hfo/agent2d_formation.hpp"
+#include "envs/hfo/goalie.hpp"
+
+namespace pamdp::hfo {
+namespace {
+
+using agent2d::Command;
+using agent2d::GoalieWorld;
+using agent2d::InterceptTable;
+using agent2d::PlayerView;
+
+Vec2 mirror(Vec2 v) {
+  return {-v.x, -v.y};
+}
+
+// Sorts players nearest to the ball first (WorldModel::teammatesFromBall / opponentsFromBall).
+template <size_t N>
+void sort_from_ball(std::array<PlayerView, N>& players, int n, Vec2 ball) {
+  for (int i = 1; i < n; ++i) {
+    const PlayerView p = players[static_cast<size_t>(i)];
+    const double d = (p.pos - ball).r2();
+    int j = i;
+    for (; j > 0 && (players[static_cast<size_t>(j - 1)].pos - ball).r2() > d; --j) {
+      players[static_cast<size_t>(j)] = players[static_cast<size_t>(j - 1)];
+    }
+    players[static_cast<size_t>(j)] = p;
+  }
+}
+
+// Line through p along `deg`, met with the goal line: Ray2D::intersection in Bhv_BasicTackle.
+bool ball_into_our_goal(const GoalieWorld& w, Vec2 self_reach_point) {
+  if (self_reach_point.x >= -kPitchHalfLength || w.ball_vel.r2() <= 0.0) {
+    return false;
+  }
+  if (w.ball_vel.x >= 0.0) {
+    return false;  // the ray never reaches x = -52.5 ahead of the ball
+  }
+  const double t = (-kPitchHalfLength - w.ball_pos.x) / w.ball_vel.x;
+  const double y = w.ball_pos.y + w.ball_vel.y * t;
+  return std::fabs(y) < kGoalHalfWidth + 1.0;
+}
+
+// Bhv_BasicTackle(0.8, 80)::execute with its version-14 foul option.
+bool basic_tackle(const GoalieWorld& w, const InterceptTable& t, DefenderDecision* d) {
+  double prob = tackle_success_probability(w, false);
+  bool foul = false;
+  const double foul_prob = tackle_success_probability(w, true);
+  if ((w.ball_pos.x > agent2d::kOurPenaltyLineX + 0.5 || std::fabs(w.ball_pos.y) > kPenaltyBoxHalfWidth + 0.5) &&
+      prob < foul_prob) {
+    prob = foul_prob;
+    foul = true;
+  }
+  if (prob < 0.8) {
+    return false;
+  }
+  const int self_min = t.self_reach_cycle;
+  const int mate_min = t.teammate_reach_cycle;
+  const int opp_min = t.opponent_reach_cycle;
+  const Vec2 their_goal{kPitchHalfLength, 0.0};
+  if (!(w.exist_kickable_opponent || ball_into_our_goal(w, agent2d::ball_inertia_point(w, self_min)) ||
+        (opp_min < self_min - 3 && opp_min < mate_min - 3) ||
+        (self_min >= 5 && (w.ball_pos - their_goal).r2() < 100.0 &&
+         std::fabs(agent2d::angle_norm(agent2d::th_deg(their_goal - w.self.pos) - w.self.body_deg)) < 45.0))) {
+    return false;
+  }
+  d->rule = DefenderDecision::Rule::kTackle;
+  d->foul = foul;
+  d->command = {Command::Kind::kTackle, agent2d::angle_norm(tackle_generator_angle(w) - w.self.body_deg), 0.0};
+  return true;
+}
+
+// Strategy::get_normal_dash_power without its memory (the recover mode, kept while stamina is
+// between half and 0.7 of the maximum; the smoothed defense line).
+double normal_dash_power(const GoalieWorld& w, const InterceptTable& t) {
+  const double my_inc = kStaminaIncMax * w.self.recovery;
+  // WorldModel::ourDefenseLineX: the second-deepest of its side (itself included), 0 at most,
+  // and the ball's x when the ball is deeper.
+  double first = 0.0;
+  double second = 0.0;
+  const auto consider = [&](double x) {
+    if (x < second) {
+      second = x;
+      if (second < first) {
+        std::swap(first, second);
+      }
+    }
+  };
+  consider(w.self.pos.x);
+  for (int i = 0; i < w.num_teammates; ++i) {
+    consider(w.teammates[static_cast<size_t>(i)].pos.x);
+  }
+  const double defense_line = std::min(second, w.ball_pos.x);
+  if (defense_line > w.self.pos.x && w.ball_pos.x < defense_line + 20.0) {
+    return kMaxDashPower;
+  }
+  if (w.self.stamina < kStaminaMax * 0.5) {
+    return std::max(0.0, my_inc - 25.0);
+  }
+  if (w.exist_kickable_teammate && w.ball_dist_from_self < 20.0) {
+    return std::min(my_inc * 1.1, kMaxDashPower);
+  }
+  if (w.ball_pos.x > 25.0 && w.ball_pos.x > w.self.pos.x + 10.0 && t.self_reach_cycle < t.opponent_reach_cycle - 6 &&
+      t.teammate_reach_cycle < t.opponent_reach_cycle - 6) {
+    return std::clamp(my_inc * 0.5, kMaxDashPower * 0.1, kMaxDashPower);
+  }
+  return std::min(my_inc * 1.7, kMaxDashPower);
+}
+
+}  // namespace
+
+GoalieWorld defender_world(const SoccerState& s, int defender, bool server_noise) {
+  const PlayerState& me = s.players[static_cast<size_t>(defender)];
+  GoalieWorld w;
+  w.self.pos = mirror(me.pos);
+  w.self.vel = mirror(me.vel);
+  w.self.body_deg = agent2d::angle_norm(me.body_deg + 180.0);
+  w.self.stamina = me.stamina;
+  w.self.effort = me.effort;
+  w.self.recovery = me.recovery;
+  w.self.capacity = me.capacity;
+  w.self.frozen = me.tackle_cycles > 0;
+  w.self.goalie = false;
+  w.ball_pos = mirror(s.ball.pos);
+  w.ball_vel = mirror(s.ball.vel);
+  w.player_rand = server_noise ? kPlayerRand : 0.0;
+  w.ball_rand = server_noise ? kBallRand : 0.0;
+  for (int i = 0; i < s.num_players; ++i) {
+    if (i == defender) {
+      continue;
+    }
+    const PlayerState& p = s.players[static_cast<size_t>(i)];
+    PlayerView v;
+    v.pos = mirror(p.pos);
+    v.vel = mirror(p.vel);
+    v.body_deg = agent2d::angle_norm(p.body_deg + 180.0);
+    v.tackling = p.tackle_cycles > 0;
+    v.goalie = p.goalie;
+    if (p.team == me.team) {
+      if (w.num_teammates < GoalieWorld::kMaxTeammates) {
+        w.teammates[static_cast<size_t>(w.num_teammates++)] = v;
+      }
+    } else if (w.num_opponents < GoalieWorld::kMaxOpponents) {
+      w.opponents[static_cast<size_t>(w.num_opponents++)] = v;
+    }
+  }
+  sort_from_ball(w.teammates, w.num_teammates, w.ball_pos);
+  sort_from_ball(w.opponents, w.num_opponents, w.ball_pos);
+  w.finish();
+  if (w.exist_kickable_opponent && !w.self_kickable) {
+    w.ball_vel = {};  // BallObject::setOpponentControlEffect
+  }
+  return w;
+}
+
+DefenderDecision decide_defender(const SoccerState& s, int defender, int unum, bool server_noise) {
+  const GoalieWorld w = defender_world(s, defender, server_noise);
+  DefenderDecision d;
+  if (w.self.frozen) {
+    d.rule = DefenderDecision::Rule::kFrozen;
+    return d;
+  }
+  // RoleCenterBack::execute: kickable unless a teammate with the ball kickable is nearer to it.
+  bool kickable = w.self_kickable;
+  if (w.exist_kickable_teammate && (w.teammates[0].pos - w.ball_pos).r() < w.ball_dist_from_self) {
+    kickable = false;
+  }
+  if (kickable) {
+    d.rule = DefenderDecision::Rule::kKick;
+    d.command = {Command::Kind::kKick, 0.0, 0.0};
+    return d;
+  }
+  InterceptTable table;
+  agent2d::predict_intercepts(w, &table);
+  if (basic_tackle(w, table, &d)) {
+    return d;
+  }
+  const int self_min = table.self_reach_cycle;
+  const int mate_min = table.teammate_reach_cycle;
+  const int opp_min = table.opponent_reach_cycle;
+  if (!w.exist_kickable_teammate && (self_min <= 3 || (self_min <= mate_min && self_min < opp_min + 3))) {
+    d.rule = DefenderDecision::Rule::kIntercept;
+    agent2d::body_intercept(w, table, true, &d.command);
+    return d;
+  }
+  // Strategy::updatePosition: the formation of the situation at the ball's inertia point after
+  // the fewest reach cycles of anyone. The offside clamp (x <= offside line - 1) never binds in
+  // HFO's half field: the attackers' "defense line" is at x >= 0 in the defenders' frame.
+  const int ball_step = std::min({1000, mate_min, opp_min, self_min});
+  const Vec2 focus = agent2d::ball_inertia_point(w, ball_step);
+  const agent2d::FormationKind kind = agent2d::formation_for(std::min(self_min, mate_min), opp_min);
+  const Vec2 target = agent2d::formation_position(agent2d::formation_data(kind), unum, focus);
+  d.rule = DefenderDecision::Rule::kBasicMove;
+  d.target = mirror(target);
+  const double dash_power = normal_dash_power(w, table);
+  const double dist_thr = std::max(1.0, w.ball_dist_from_self * 0.1);
+  if (!agent2d::body_go_to_point(w, target, dist_thr, dash_power, -1.0, 100, true, 15.0, &d.command)) {
+    agent2d::body_turn_to_point(w, agent2d::ball_inertia_point(w, 1), 1, &d.command);
+  }
+  return d;
+}
+
+}  // namespace pamdp::hfo

@@ -1,0 +1,48 @@
+// HFO's field defenders in the embedded simulator (issue 83, in progress): agent2d's CenterBack,
+// the role of unums 2 and 3 that HFO runs for --defense-npcs 2 and 3 (HFO b8b2a1d
+// src/role_center_back.cpp, bhv_basic_move.cpp, bhv_basic_tackle.cpp, strategy.cpp on librcsc
+// d222758), re-implemented from its rules on the goalie's world model and librcsc actions
+// (goalie_world.hpp; the intercept with SelfView::goalie false).
+//
+// decide_defender() is a pure function of the state at the start of a cycle. Not yet in the
+// simulator: it is checked one recorded cycle at a time against the real server's defenders
+// (tests/hfo_defender_real_data_test.cpp). What it does each cycle:
+//  - frozen by its own tackle: no body command;
+//  - the ball kickable (no teammate nearer to it): a kick (RoleCenterBack::doKick, the chain
+//    action; only the command's kind is modelled, since HFO ends the episode as captured about
+//    2 cycles later);
+//  - otherwise Bhv_BasicMove: a tackle or foul tackle (Bhv_BasicTackle(0.8, 80), TackleGenerator's
+//    direction), or intercept (Body_Intercept2009) when its own reach is at most 3 cycles or at
+//    most its field teammates' and under the opponents' + 3, or go to its home position
+//    (agent2d_formation.hpp) with Body_GoToPoint at Strategy::get_normal_dash_power, or turn to
+//    the ball when there.
+// Its world model is the truth (both teams get full state), with librcsc's one correction: the
+// ball's velocity is believed 0 while an opponent can kick it and the defender cannot
+// (WorldModel::updateJustBeforeDecision -> BallObject::setOpponentControlEffect). Memory agent2d
+// keeps across cycles (Strategy's recover mode, WorldModel's smoothed defense line) and what the
+// defenders tell each other are not modelled yet.
+#pragma once
+
+#include "envs/hfo/goalie_world.hpp"
+#include "envs/hfo/soccer_sim.hpp"
+
+namespace pamdp::hfo {
+
+// What a defender decided, with the .dcl's vocabulary for checking (BasicMove target point).
+struct DefenderDecision {
+  enum class Rule : uint8_t { kFrozen, kKick, kTackle, kIntercept, kBasicMove };
+  Rule rule = Rule::kBasicMove;
+  agent2d::Command command;
+  bool foul = false;  // a foul tackle ((tackle DIR on))
+  Vec2 target;        // kBasicMove: the home position, in the global frame
+};
+
+// The defender's world model, mirrored into its own frame (goalie_world.hpp): its teammates are
+// the other defense players (the goalie flagged), its opponents the offense.
+agent2d::GoalieWorld defender_world(const SoccerState& state, int defender, bool server_noise);
+
+// The defender's decision this cycle; `defender` indexes state.players, `unum` is its uniform
+// number (2 or 3: its place in agent2d's formation).
+DefenderDecision decide_defender(const SoccerState& state, int defender, int unum, bool server_noise);
+
+}  // namespace pamdp::hfo
