@@ -48,7 +48,7 @@ inline std::unique_ptr<Policy> make_teacher(const ExperimentConfig& c) {
   const int agents =
       c.env.params.contains("offense_agents") ? static_cast<int>(c.env.params.integer("offense_agents")) : 1;
   if (agents > 1) {
-    const int opponents = c.env.params.contains("goalie") && c.env.params.boolean("goalie") ? 1 : 0;
+    const int opponents = hfo::defense_players(c.env.params);
     return std::make_unique<hfo::ScriptedTeamPlayer>(agents - 1, opponents, shoot, c.demo_pass_within);
   }
   return std::make_unique<hfo::ScriptedOffense>(c.demo_shot, shoot);

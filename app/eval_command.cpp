@@ -359,7 +359,7 @@ void run_team_eval(const EvalOptions& o, const CLI::App& cmd) {
   std::vector<Policy*> slots;
   for (int i = 0; i < n; ++i) {
     if (o.policy == "scripted") {
-      players.push_back(std::make_unique<hfo::ScriptedTeamPlayer>(n - 1, c.env.params.boolean("goalie") ? 1 : 0,
+      players.push_back(std::make_unique<hfo::ScriptedTeamPlayer>(n - 1, hfo::defense_players(c.env.params),
                                                                   hfo::shoot_action(c.env.params)));
     } else {
       auto random = std::make_unique<RandomPolicy>(env->action_space(), (o.seed ^ 0x5eedULL) + static_cast<uint64_t>(i),
@@ -429,7 +429,7 @@ void run_eval(const EvalOptions& o, const CLI::App& cmd) {
           "--shot aims the single striker's shots; a team player (env.offense_agents > 1) "
           "plays the close-in offense: leave out --shot");
     }
-    policy = std::make_unique<hfo::ScriptedTeamPlayer>(teammates, c.env.params.boolean("goalie") ? 1 : 0,
+    policy = std::make_unique<hfo::ScriptedTeamPlayer>(teammates, hfo::defense_players(c.env.params),
                                                        hfo::shoot_action(c.env.params));
   } else if (o.policy == "scripted") {
     policy = std::make_unique<hfo::ScriptedOffense>(o.shot, hfo::shoot_action(c.env.params));

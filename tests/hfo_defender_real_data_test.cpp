@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -156,6 +157,111 @@ void expect_agreement(const Tally& t) {
   EXPECT_GE(t.command / n, 0.985);
   EXPECT_GE(t.rule / n, 0.98);
   EXPECT_GE(static_cast<double>(t.target) / std::max(1, t.move_rows), 0.985);
+}
+
+// The embedded game stepped from each recorded state: the attackers send their recorded
+// commands, the goalie and the field defenders decide for themselves (SoccerSim with
+// field_defenders), and every field defender's next position, velocity and body must match the
+// next recorded row (0.01 m, 0.01 m/cycle, 0.5 deg). Issue 83's target: 97 %.
+struct Stepped {
+  int defender_cycles = 0;
+  int defender_ok = 0;
+  int rows = 0;
+  int all_ok = 0;  // every object (ball, attackers, goalie, defenders)
+};
+
+Stepped step_game(const std::string& file, int agents, int field_defenders, bool verbose) {
+  const std::vector<CsvRow> rows = testing::load_csv_rows(std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file);
+  Stepped out;
+  int shown = 0;
+  for (size_t i = 0; i + 1 < rows.size(); ++i) {
+    const CsvRow& r = rows[i];
+    const CsvRow& n = rows[i + 1];
+    if (r.str("status") != "IN_GAME" || n.str("src") != r.str("src") || n.str("ep") != r.str("ep") || r.num("t") < 2) {
+      continue;  // the reset cycles and the last row of an episode
+    }
+    SoccerSimConfig cfg;
+    cfg.noise = false;
+    cfg.offense_agents = agents;
+    cfg.goalie = true;
+    cfg.field_defenders = field_defenders;
+    SoccerSim sim(cfg, 1);
+    std::vector<PlayerState> offense;
+    for (int a = 0; a < agents; ++a) {
+      PlayerState p = player_at(r, "p" + std::to_string(a), true);
+      p.tackle_cycles = static_cast<int>(r.num("p" + std::to_string(a) + "_frozen"));
+      offense.push_back(p);
+    }
+    sim.set_state(offense, BallState{{r.num("bx"), r.num("by")}, {r.num("bvx"), r.num("bvy")}});
+    PlayerState g = player_at(r, "g", true);
+    g.tackle_cycles = static_cast<int>(r.num("g_frozen"));
+    sim.set_goalie(g);
+    for (int k = 0; k < field_defenders; ++k) {
+      const std::string d = "d" + std::to_string(k + 1);
+      PlayerState p = player_at(r, d, false);
+      const std::string cmd = r.str(d + "_cmd");
+      p.tackle_cycles = cmd.empty() || cmd == "NONE" ? 1 : 0;
+      sim.set_defender(k, p);
+    }
+    for (int a = 0; a < agents; ++a) {
+      const std::string p = "p" + std::to_string(a);
+      const std::string cmd = r.str(p + "_cmd");
+      std::optional<bool> tackle_ok;
+      if (cmd == "TACKLE") {
+        tackle_ok = (std::stol(n.str(p + "_state"), nullptr, 16) & 0x1000) != 0;
+      }
+      if (!cmd.empty()) {
+        sim.command_as_received(a, cmd.c_str(), r.num(p + "_c1"), r.num(p + "_c2"), tackle_ok);
+      }
+    }
+    sim.step();
+    ++out.rows;
+    const SoccerState& s = sim.state();
+    const auto same = [&](const PlayerState& p, const std::string& col) {
+      return std::hypot(p.pos.x - n.num(col + "_x"), p.pos.y - n.num(col + "_y")) <= 0.01 &&
+             std::hypot(p.vel.x - n.num(col + "_vx"), p.vel.y - n.num(col + "_vy")) <= 0.01 &&
+             std::fabs(wrap_deg(p.body_deg - n.num(col + "_body"))) <= 0.5;
+    };
+    bool all = std::hypot(s.ball.pos.x - n.num("bx"), s.ball.pos.y - n.num("by")) <= 0.01;
+    for (int a = 0; a < agents; ++a) {
+      all = all && same(s.players[static_cast<size_t>(a)], "p" + std::to_string(a));
+    }
+    all = all && same(s.players[static_cast<size_t>(sim.goalie_index())], "g");
+    for (int k = 0; k < field_defenders; ++k) {
+      const std::string d = "d" + std::to_string(k + 1);
+      const PlayerState& p = s.players[static_cast<size_t>(sim.defender_index(k))];
+      const bool ok = same(p, d);
+      ++out.defender_cycles;
+      out.defender_ok += ok ? 1 : 0;
+      all = all && ok;
+      if (!ok && verbose && shown < 30) {
+        ++shown;
+        std::printf(
+            "%s ep %s t %s %s: next (%.4f, %.4f) body %.2f, real (%s, %s) body %s; cmd real %s %s, ours %s %.3f\n",
+            file.c_str(), r.str("ep").c_str(), r.str("t").c_str(), d.c_str(), p.pos.x, p.pos.y, p.body_deg,
+            n.str(d + "_x").c_str(), n.str(d + "_y").c_str(), n.str(d + "_body").c_str(), r.str(d + "_cmd").c_str(),
+            r.str(d + "_c1").c_str(), kind_name(static_cast<agent2d::Command::Kind>(sim.last_defender_command(k).kind)),
+            sim.last_defender_command(k).p1);
+      }
+    }
+    out.all_ok += all ? 1 : 0;
+  }
+  std::printf("%s: stepped %d cycles; each field defender's next state on %.1f %% of %d, every object's on %.1f %%\n",
+              file.c_str(), out.rows, 100.0 * out.defender_ok / std::max(1, out.defender_cycles), out.defender_cycles,
+              100.0 * out.all_ok / std::max(1, out.rows));
+  return out;
+}
+
+void expect_next_states(const Stepped& s) {
+  EXPECT_GT(s.defender_cycles, 500);
+  EXPECT_GE(static_cast<double>(s.defender_ok) / std::max(1, s.defender_cycles), 0.97);
+}
+
+TEST(DefenderRealData, TheGameStepsToTheRecordedDefenderStates) {
+  const bool verbose = std::getenv("PAMDP_VERBOSE") != nullptr;
+  expect_next_states(step_game("hfo-real-defense-1v2.csv", 1, 1, verbose));
+  expect_next_states(step_game("hfo-real-defense-2v2.csv", 2, 1, verbose));
+  expect_next_states(step_game("hfo-real-defense-1v3.csv", 1, 2, verbose));
 }
 
 TEST(DefenderRealData, OneAttackerAgainstTheGoalieAndAFieldDefender) {

@@ -748,6 +748,15 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_
   w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {
     const PlayerState& p = s.players[i];
+    if (i != goalie && p.team == me.team && w.num_teammates < GoalieWorld::kMaxTeammates) {
+      // agent2d's field defenders: the goalie's teammates in its intercept table.
+      agent2d::PlayerView& t = w.teammates[w.num_teammates++];
+      t.pos = mirror(p.pos);
+      t.vel = mirror(p.vel);
+      t.body_deg = angle_norm(p.body_deg + 180.0);
+      t.tackling = p.tackle_cycles > 0;
+      continue;
+    }
     if (p.team == me.team || w.num_opponents == GoalieWorld::kMaxOpponents) {
       continue;
     }
@@ -767,6 +776,15 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_
       w.opponents[j] = w.opponents[j - 1];
     }
     w.opponents[j] = o;
+  }
+  for (int i = 1; i < w.num_teammates; ++i) {
+    const agent2d::PlayerView t = w.teammates[i];
+    const double d = (t.pos - w.ball_pos).r2();
+    int j = i;
+    for (; j > 0 && (w.teammates[j - 1].pos - w.ball_pos).r2() > d; --j) {
+      w.teammates[j] = w.teammates[j - 1];
+    }
+    w.teammates[j] = t;
   }
   w.finish();
   return w;

@@ -92,8 +92,8 @@ struct GoalieWorld {
   // Opponents sorted by distance to the ball (WorldModel::opponentsFromBall).
   std::array<PlayerView, kMaxOpponents> opponents{};
   int num_opponents = 0;
-  // Teammates sorted by distance to the ball (a field defender's: the goalie and the other
-  // field defenders; none for the goalie, which ignores its field teammates here).
+  // Teammates sorted by distance to the ball: the goalie's are the field defenders, a field
+  // defender's the goalie (flagged) and the other field defenders.
   static constexpr int kMaxTeammates = 3;
   std::array<PlayerView, kMaxTeammates> teammates{};
   int num_teammates = 0;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 
@@ -63,6 +64,16 @@ EnvKey goalie_key() {
   return EnvKey::boolean("goalie", SoccerSimConfig{}.goalie);
 }
 
+EnvKey defense_npcs_key() {
+  return EnvKey::integer("defense_npcs", 0, 0, 1 + kMaxFieldDefenders);
+}
+
+int defense_players(const EnvParams& params) {
+  const int goalie = params.contains("goalie") && params.boolean("goalie") ? 1 : 0;
+  const int npcs = params.contains("defense_npcs") ? static_cast<int>(params.integer("defense_npcs")) : 0;
+  return std::max(goalie, npcs);
+}
+
 EnvKey shoot_action_key() {
   return EnvKey::boolean("shoot_action", false);
 }
@@ -89,7 +100,8 @@ std::vector<EnvKey> sim_keys() {
       max_steps_key(),
       EnvKey::integer("untouched_limit", d.untouched_limit, 1, 1000000),
       goalie_key(),
-      offense_agents_key()};
+      offense_agents_key(),
+      defense_npcs_key()};
 }
 
 SoccerSimConfig sim_config(const EnvParams& params) {
@@ -101,6 +113,9 @@ SoccerSimConfig sim_config(const EnvParams& params) {
   c.max_steps = static_cast<int>(params.integer("max_steps"));
   c.untouched_limit = static_cast<int>(params.integer("untouched_limit"));
   c.goalie = params.boolean("goalie");
+  const int64_t defense_npcs = params.contains("defense_npcs") ? params.integer("defense_npcs") : 0;
+  c.goalie = c.goalie || defense_npcs >= 1;
+  c.field_defenders = static_cast<int>(std::max<int64_t>(0, defense_npcs - 1));
   c.offense_agents = static_cast<int>(params.integer("offense_agents"));
   return c;
 }
@@ -113,6 +128,7 @@ void set_sim_config(EnvParams& params, const SoccerSimConfig& config) {
   params.set("max_steps", int64_t{config.max_steps});
   params.set("untouched_limit", int64_t{config.untouched_limit});
   params.set("goalie", config.goalie);
+  params.set("defense_npcs", int64_t{config.field_defenders > 0 ? 1 + config.field_defenders : 0});
   params.set("offense_agents", int64_t{config.offense_agents});
 }
 
@@ -123,7 +139,7 @@ void register_hfo_env(EnvRegistry& registry) {
   r.name = "hfo";
   r.description =
       "embedded Half Field Offense simulator (58 features; 66 with env.goalie = true; 8 more per teammate with "
-      "env.offense_agents = N, a team of N learned players)";
+      "env.offense_agents = N, a team of N learned players, and per field defender with env.defense_npcs = K)";
   r.keys = hfo::sim_keys();
   r.keys.push_back(hfo::shoot_action_key());
   // Subtracted from the reward when the ball goes out of bounds (hfo::ShapedReward); 0 keeps

@@ -20,6 +20,13 @@ const Names<BodyAtReset>& body_at_reset_names();  // carry, zero, uniform
 
 // The keys, with SoccerSimConfig's defaults.
 EnvKey goalie_key();
+// env.defense_npcs: HFO's --defense-npcs K (0-3): the goalie, then K - 1 of agent2d's field
+// defenders (SoccerSimConfig::field_defenders). K >= 1 implies env.goalie; 0 leaves it to
+// env.goalie.
+EnvKey defense_npcs_key();
+// The defense players of a game the env.* keys describe: the goalie (env.goalie or
+// env.defense_npcs >= 1) and the field defenders (env.defense_npcs - 1); keys missing count 0.
+int defense_players(const EnvParams& params);
 EnvKey max_steps_key();
 // env.offense_agents: HFO's --offense-agents N (1-4). The embedded game plays all N as one team
 // env (Env::agents() = N); on the real server each env is one of the N.

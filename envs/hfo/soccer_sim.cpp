@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "envs/hfo/client_effector.hpp"
+#include "envs/hfo/defender.hpp"
 #include "envs/hfo/goalie.hpp"
 
 namespace pamdp::hfo {
@@ -70,6 +71,11 @@ SoccerSim::SoccerSim(const SoccerSimConfig& config, uint64_t seed) : config_(con
   if (config_.offense_agents < 1 || config_.offense_agents > kMaxOffenseAgents) {
     throw std::invalid_argument("SoccerSim: offense_agents must be within [1, " + std::to_string(kMaxOffenseAgents) +
                                 "], got " + std::to_string(config_.offense_agents));
+  }
+  if (config_.field_defenders < 0 || config_.field_defenders > kMaxFieldDefenders ||
+      (config_.field_defenders > 0 && !config_.goalie)) {
+    throw std::invalid_argument("SoccerSim: field_defenders must be within [0, " + std::to_string(kMaxFieldDefenders) +
+                                "] and needs the goalie, got " + std::to_string(config_.field_defenders));
   }
   std::array<PlayerState, kMaxOffenseAgents> offense{};
   for (int i = 0; i < config_.offense_agents; ++i) {
@@ -163,9 +169,22 @@ void SoccerSim::reset_episode() {
   // terminal state (HFORef::analyse) counts for them; the goalie's command in that cycle is
   // not played here.
   const PlayerState old_goalie = state_.players[goalie_index()];
+  std::array<PlayerState, kMaxFieldDefenders> old_defenders{};
+  for (int k = 0; k < config_.field_defenders; ++k) {
+    old_defenders[static_cast<size_t>(k)] = state_.players[defender_index(k)];
+  }
   set_state(std::span<const PlayerState>(offense.data(), n), BallState{{bx, by}, {0.0, 0.0}});
   if (!config_.goalie) {
     return;
+  }
+  // Field defenders (HFORef::resetField): x U[42, 52.5], y U[-27.2, 27.2], placed and recovered
+  // as the goalie is; drawn after the offense so that games without them draw as before.
+  for (int k = 0; k < config_.field_defenders; ++k) {
+    PlayerState& d = state_.players[defender_index(k)];
+    const PlayerState& old = old_defenders[static_cast<size_t>(k)];
+    d.pos = {rng_.uniform(kDefenderStartMinX, kPitchHalfLength), rng_.uniform(-kDefenderStartMaxY, kDefenderStartMaxY)};
+    d.body_deg = old.body_deg;
+    d.tackle_cycles = std::max(0, old.tackle_cycles - 1);
   }
   PlayerState& g = state_.players[goalie_index()];
   g.body_deg = old_goalie.body_deg;  // the constructor's set_state gave it 180 to start
@@ -173,8 +192,8 @@ void SoccerSim::reset_episode() {
   g.catch_ban = std::max(0, old_goalie.catch_ban - 1);
   g.since_catch = std::min(PlayerState::kNoCatchYet, old_goalie.since_catch + 1);
   // HFO's client plays NOOPs for the first two cycles of an episode, so its first observation
-  // comes two cycles after the reset (docs/hfo-server.md); the goalie plays in both. Only the
-  // goalie moves: the ball is at rest and the agents send nothing.
+  // comes two cycles after the reset (docs/hfo-server.md); the goalie (and the field defenders)
+  // play in both. Only the defense moves: the ball is at rest and the agents send nothing.
   for (int i = 0; i < kCyclesBeforeFirstObservation; ++i) {
     step();
   }
@@ -213,10 +232,33 @@ void SoccerSim::set_state(std::span<const PlayerState> offense, const BallState&
     goalie.goalie = true;
     state_.players[goalie_index()] = goalie;
     state_.num_players = goalie_index() + 1;
+    // Field defenders, until a reset draws their places: on the penalty spots' x, either side.
+    for (int k = 0; k < config_.field_defenders; ++k) {
+      PlayerState d;
+      d.pos = {kDefenderStartMinX + 5.0, k == 0 ? -10.0 : 10.0};
+      d.body_deg = kGoalieStartBodyDeg;
+      d.team = Team::kDefense;
+      state_.players[defender_index(k)] = d;
+      state_.num_players = defender_index(k) + 1;
+    }
   }
   player_accel_.fill(Vec2{});
   ball_accel_ = {};
   last_goalie_command_ = {};
+  last_defender_command_.fill({});
+  goalie_sensed_ = false;
+}
+
+void SoccerSim::set_defender(int k, const PlayerState& defender) {
+  if (k < 0 || k >= config_.field_defenders) {
+    throw std::invalid_argument("SoccerSim::set_defender: field defender " + std::to_string(k) + " of " +
+                                std::to_string(config_.field_defenders));
+  }
+  PlayerState& d = state_.players[defender_index(k)];
+  d = defender;
+  d.team = Team::kDefense;
+  d.goalie = false;
+  d.body_deg = wrap_deg(defender.body_deg);
   goalie_sensed_ = false;
 }
 
@@ -377,12 +419,26 @@ bool SoccerSim::kick_player_server(int i, double power, double dir_deg) {
   return true;
 }
 
-bool SoccerSim::server_tackle(int i, double dir_deg, std::optional<bool> succeeds) {
+bool SoccerSim::server_tackle(int i, double dir_deg, std::optional<bool> succeeds, bool foul) {
   PlayerState& p = state_.players[i];
   if (p.tackle_cycles > 0) {
     return false;
   }
   p.tackle_cycles = kTackleCycles;
+  // Player::tackle: a foul counts only while an opponent can kick the ball; it is then judged
+  // with foul_exponent, and a successful one does not freeze the tackler.
+  double exponent = kTackleExponent;
+  if (foul) {
+    foul = false;
+    for (int j = 0; j < state_.num_players; ++j) {
+      const PlayerState& o = state_.players[j];
+      if (o.team != p.team && (state_.ball.pos - o.pos).r() <= kKickableArea) {
+        foul = true;
+        exponent = kFoulExponent;
+        break;
+      }
+    }
+  }
   // Ball in the body frame.
   const Vec2 d = state_.ball.pos - p.pos;
   const double body = p.body_deg * kDegToRad;
@@ -392,14 +448,16 @@ bool SoccerSim::server_tackle(int i, double dir_deg, std::optional<bool> succeed
   if (q.x <= 0.0) {
     return true;  // the back tackle distance is 0: always fails
   }
-  const double fail =
-      std::pow(q.x / kTackleDist, kTackleExponent) + std::pow(std::fabs(q.y) / kTackleWidth, kTackleExponent);
+  const double fail = std::pow(q.x / kTackleDist, exponent) + std::pow(std::fabs(q.y) / kTackleWidth, exponent);
   if (fail >= 1.0) {
     return true;
   }
   // Success is drawn from the server's generator even with noise off (a replay may give it).
   if (succeeds ? !*succeeds : rng_.uniform() < fail) {
     return true;
+  }
+  if (foul) {
+    p.tackle_cycles = 0;
   }
   const double a_deg = clamp(wrap_deg(dir_deg), kMinMoment, kMaxMoment);
   const double power = kMaxTacklePower + (kMaxBackTacklePower - kMaxTacklePower) * std::fabs(a_deg) / 180.0;
@@ -488,7 +546,32 @@ void SoccerSim::sense_goalie() {
   }
   const GoalieCommand c = decide_goalie(state_, goalie_index(), config_.noise);
   pending_goalie_command_ = {static_cast<uint8_t>(c.kind), c.p1, c.p2};
+  // The field defenders sense the same state in the same moment.
+  for (int k = 0; k < config_.field_defenders; ++k) {
+    const DefenderDecision d = decide_defender(state_, defender_index(k), k + 2, config_.noise);
+    pending_defender_command_[static_cast<size_t>(k)] = {static_cast<uint8_t>(d.command.kind), d.command.p1,
+                                                         d.command.p2, d.foul};
+  }
   goalie_sensed_ = true;
+}
+
+void SoccerSim::play_npc_command(int i, const GoalieCommandLog& c) {
+  switch (static_cast<GoalieCommand::Kind>(c.kind)) {
+    case GoalieCommand::Kind::kDash: server_dash(i, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTurn: server_turn(i, c.p1); break;
+    case GoalieCommand::Kind::kKick: send_kick(i, c.p1, c.p2); break;
+    case GoalieCommand::Kind::kTackle: server_tackle(i, c.p1, std::nullopt, c.foul); break;
+    case GoalieCommand::Kind::kCatch:
+    case GoalieCommand::Kind::kNone: break;
+  }
+}
+
+void SoccerSim::play_defenders() {
+  for (int k = 0; k < config_.field_defenders; ++k) {
+    const GoalieCommandLog& c = pending_defender_command_[static_cast<size_t>(k)];
+    last_defender_command_[static_cast<size_t>(k)] = c;
+    play_npc_command(defender_index(k), c);
+  }
 }
 
 void SoccerSim::play_goalie() {
@@ -667,8 +750,10 @@ void SoccerSim::update_stamina(PlayerState& p) {
 
 int SoccerSim::step() {
   if (config_.goalie) {
-    // The goalie sees the same state as the agent did and acts in the same cycle.
+    // The goalie and the field defenders see the same state as the agent did and act in the
+    // same cycle.
     play_goalie();
+    play_defenders();
   }
   const int np = state_.num_players;
   for (int i = 0; i < np; ++i) {
@@ -716,31 +801,41 @@ int SoccerSim::referee_server() {
   if (prev.x < 0.0 || prev.x > kPitchHalfLength || std::fabs(prev.y) > kPitchHalfWidth) {
     return kOutOfBounds;
   }
-  bool defense_near = false;
-  bool goalie_near = false;
-  bool anyone_near = false;
-  for (int i = 0; i < state_.num_players; ++i) {
-    const PlayerState& p = state_.players[i];
-    if ((ball - p.pos).r() <= kKickableArea) {
-      anyone_near = true;
-      if (p.team == Team::kDefense) {
-        defense_near = true;
-        goalie_near = goalie_near || p.goalie;
-      }
-    }
-  }
-  state_.defense_hold = defense_near ? state_.defense_hold + 1 : 0;
-  // The goalie within the kickable area ends it at once (HFORef::analyse); a catch alone does
-  // not: in HFO mode the ball flies on, and only a ball that ends within reach is captured.
-  if (goalie_near || state_.defense_hold >= 2) {
+  // HFORef::analyse: the defense has held the ball for TURNOVER_TIME (2) checks.
+  if (state_.defense_hold >= 2) {
     return kCapturedByDefense;
   }
   if (state_.untouched > config_.untouched_limit || state_.cycle > config_.max_steps) {
     return kOutOfTime;
   }
   ++state_.untouched;
-  if (anyone_near) {
+  // In the server's order (offense, then the goalie, then the field defenders): the first
+  // defender within the kickable area holds the ball and counts a check; otherwise an attacker
+  // within it resets the count; with nobody near, the count stays.
+  bool offense_near = false;
+  bool goalie_holds = false;
+  for (int i = 0; i < state_.num_players; ++i) {
+    const PlayerState& p = state_.players[i];
+    if ((ball - p.pos).r() > kKickableArea) {
+      continue;
+    }
     state_.untouched = 0;
+    if (p.team == Team::kOffense) {
+      offense_near = true;
+      continue;
+    }
+    offense_near = false;
+    ++state_.defense_hold;
+    goalie_holds = p.goalie;
+    break;
+  }
+  if (offense_near) {
+    state_.defense_hold = 0;
+  }
+  // The goalie with the ball ends it at once; a catch alone does not: in HFO mode the ball flies
+  // on, and only a ball that ends within reach is captured.
+  if (goalie_holds) {
+    return kCapturedByDefense;
   }
   return kInGame;
 }

@@ -65,6 +65,10 @@ struct SoccerSimConfig {
   int max_steps = 500;        // --frames-per-trial used by dqn-hfo
   int untouched_limit = 100;  // cycles the ball may stay untouched
   bool goalie = false;        // an NPC goalie defends the goal (1v1): players()[1], 66 features
+  // agent2d's field defenders beside the goalie (HFO's --defense-npcs K gives K - 1; needs the
+  // goalie): players()[goalie_index() + 1 ...], each an opponent block of 8 features. 0-2.
+  // Their decisions: defender.hpp.
+  int field_defenders = 0;
   // Learned offense players, HFO's --offense-agents (1-4): players()[0 .. offense_agents - 1].
   int offense_agents = 1;
   // A curriculum over training (not HFO's; issue 80): a start drawn from `start` has the ball and
@@ -76,6 +80,11 @@ struct SoccerSimConfig {
 };
 
 inline constexpr int kMaxOffenseAgents = 4;
+inline constexpr int kMaxFieldDefenders = 2;
+// Where HFO puts agent2d's field defenders at every reset (HFORef::resetField): x U[0.4, 0.5] of
+// the pitch length, y U[-0.4, 0.4] of its width.
+inline constexpr double kDefenderStartMinX = 0.4 * 2.0 * kPitchHalfLength;
+inline constexpr double kDefenderStartMaxY = 0.4 * 2.0 * kPitchHalfWidth;
 // Index of the NPC goalie in SoccerState::players when SoccerSimConfig::goalie is on and there
 // is one offense agent; in general SoccerSim::goalie_index() (= offense_agents).
 inline constexpr int kGoalieIndex = 1;
@@ -153,6 +162,8 @@ class SoccerSim {
   void set_state(const PlayerState& agent, const BallState& ball);
   // Replaces the goalie's state after set_state (traces); its team and role are kept.
   void set_goalie(const PlayerState& goalie);
+  // Replaces field defender k's state after set_state (0 .. field_defenders - 1); its team is kept.
+  void set_defender(int k, const PlayerState& defender);
   [[nodiscard]] const SoccerState& state() const { return state_; }
   SoccerState& mutable_state() { return state_; }
   [[nodiscard]] const PlayerState& agent() const { return state_.players[0]; }
@@ -160,6 +171,9 @@ class SoccerSim {
   [[nodiscard]] int offense_agents() const { return config_.offense_agents; }
   // Index of the goalie in state().players (meaningful with config().goalie).
   [[nodiscard]] int goalie_index() const { return config_.offense_agents; }
+  // Index of field defender k (0 .. config().field_defenders - 1); its unum in agent2d's
+  // formation is k + 2.
+  [[nodiscard]] int defender_index(int k) const { return config_.offense_agents + 1 + k; }
 
   // Agent commands, as the HFO agent issues them through librcsc (client-side clamping,
   // wrapping, gating and compensation, then the server's handling). At most one per cycle;
@@ -190,8 +204,13 @@ class SoccerSim {
     uint8_t kind = 0;  // agent2d::Command::Kind
     double p1 = 0.0;
     double p2 = 0.0;
+    bool foul = false;  // a foul tackle ((tackle DIR on))
   };
   [[nodiscard]] const GoalieCommandLog& last_goalie_command() const { return last_goalie_command_; }
+  // The command field defender k sent in the last step() (a foul tackle has foul set).
+  [[nodiscard]] const GoalieCommandLog& last_defender_command(int k) const {
+    return last_defender_command_[static_cast<size_t>(k)];
+  }
 
   // A body command exactly as the server received it from `player`'s client (recorded logs,
   // the goalie): DASH power dir, TURN moment, KICK power dir, TACKLE dir, CATCH dir; no client
@@ -216,11 +235,13 @@ class SoccerSim {
   bool kick_player_server(int i, double power, double dir_deg);
   bool server_dash(int i, double power, double dir_deg);
   bool server_turn(int i, double moment);
-  bool server_tackle(int i, double dir_deg, std::optional<bool> succeeds = std::nullopt);
+  bool server_tackle(int i, double dir_deg, std::optional<bool> succeeds = std::nullopt, bool foul = false);
   // The goalie senses the cycle's state before any command of the cycle changes it (a turn
   // takes effect when the server receives it): decided once, at the first command or step().
   void sense_goalie();
   void play_goalie();
+  void play_defenders();
+  void play_npc_command(int i, const GoalieCommandLog& c);
   void move_object(Vec2& pos, Vec2& vel, Vec2& accel, double size, double decay, double accel_max, double speed_max,
                    double rand, bool* hit_post);
   void collide_objects();
@@ -239,6 +260,8 @@ class SoccerSim {
   GoalieCommandLog last_goalie_command_;
   GoalieCommandLog pending_goalie_command_;
   bool goalie_sensed_ = false;
+  std::array<GoalieCommandLog, kMaxFieldDefenders> last_defender_command_{};
+  std::array<GoalieCommandLog, kMaxFieldDefenders> pending_defender_command_{};
 };
 
 }  // namespace pamdp::hfo

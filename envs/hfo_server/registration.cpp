@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -50,7 +51,7 @@ HfoServerConfig server_config(const EnvParams& p) {
   s.encoding = p.text("server_encoding") == "embedded" ? Encoding::kEmbedded : Encoding::kNative;
   s.team = p.text("server_team");
   s.config_dir = p.text("server_config_dir");
-  s.opponents = p.boolean("goalie") ? 1 : 0;
+  s.opponents = hfo::defense_players(p);
   s.teammates = static_cast<int>(p.integer("offense_agents")) - 1;
   s.max_steps = static_cast<int>(p.integer("max_steps"));
   s.connect_timeout_s = static_cast<int>(p.integer("server_connect_timeout_s"));
@@ -69,7 +70,7 @@ void register_hfo_server_env(EnvRegistry& registry) {
       "docs/hfo-server.md)";
   // Of the embedded simulator's keys, goalie says the server runs one (bin/HFO --defense-npcs 1),
   // max_steps is its --frames-per-trial and shoot_action adds SHOOT, sent as a KICK.
-  r.keys = {hfo::goalie_key(), hfo::max_steps_key(), EnvKey::text("server_host", d.host),
+  r.keys = {hfo::goalie_key(), hfo::defense_npcs_key(), hfo::max_steps_key(), EnvKey::text("server_host", d.host),
             EnvKey::integer("server_port", d.port, 1, 65535),
             // The server of the greedy evaluations that `pamdp train` and `pamdp learner` run; 0 = none.
             EnvKey::integer("server_eval_port", 0, 0, 65535),
