@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "csv_rows.hpp"
@@ -255,6 +256,98 @@ Stepped step_game(const std::string& file, int agents, int field_defenders, bool
 void expect_next_states(const Stepped& s) {
   EXPECT_GT(s.defender_cycles, 500);
   EXPECT_GE(static_cast<double>(s.defender_ok) / std::max(1, s.defender_cycles), 0.97);
+}
+
+// Whole recorded episodes played again from their first state two cycles in: the attackers send
+// their recorded commands, the defense decides for itself; the episode must end as recorded
+// (issue 83's target: 90 %). Commands that no longer fit a game drifted away are sent as recorded.
+struct Endings {
+  int episodes = 0;
+  int same = 0;
+};
+
+Endings play_episodes(const std::string& file, int agents, int field_defenders, bool verbose) {
+  const std::vector<CsvRow> rows = testing::load_csv_rows(std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file);
+  Endings out;
+  size_t i = 0;
+  while (i < rows.size()) {
+    size_t end = i;
+    while (end + 1 < rows.size() && rows[end + 1].str("src") == rows[i].str("src") &&
+           rows[end + 1].str("ep") == rows[i].str("ep")) {
+      ++end;
+    }
+    const std::string recorded = rows[end].str("status");
+    size_t first = i;
+    while (first <= end && rows[first].num("t") < 2) {
+      ++first;
+    }
+    if (first <= end && recorded != "IN_GAME" && rows[first].str("status") == "IN_GAME") {
+      const CsvRow& r = rows[first];
+      SoccerSimConfig cfg;
+      cfg.noise = false;
+      cfg.offense_agents = agents;
+      cfg.goalie = true;
+      cfg.field_defenders = field_defenders;
+      SoccerSim sim(cfg, 1);
+      std::vector<PlayerState> offense;
+      for (int a = 0; a < agents; ++a) {
+        offense.push_back(player_at(r, "p" + std::to_string(a), true));
+      }
+      sim.set_state(offense, BallState{{r.num("bx"), r.num("by")}, {r.num("bvx"), r.num("bvy")}});
+      sim.set_goalie(player_at(r, "g", true));
+      for (int k = 0; k < field_defenders; ++k) {
+        sim.set_defender(k, player_at(r, "d" + std::to_string(k + 1), false));
+      }
+      // The referee's counters at this state: the ball untouched since the reset, nobody held.
+      sim.mutable_state().cycle = static_cast<int>(r.num("t"));
+      sim.mutable_state().untouched = static_cast<int>(r.num("t"));
+      int status = kInGame;
+      for (size_t k = first; k <= end && status == kInGame; ++k) {
+        const CsvRow& c = rows[k];
+        for (int a = 0; a < agents; ++a) {
+          const std::string p = "p" + std::to_string(a);
+          const std::string cmd = c.str(p + "_cmd");
+          if (!cmd.empty()) {
+            std::optional<bool> tackle_ok;
+            if (cmd == "TACKLE" && k + 1 <= end) {
+              tackle_ok = (std::stol(rows[k + 1].str(p + "_state"), nullptr, 16) & 0x1000) != 0;
+            }
+            sim.command_as_received(a, cmd.c_str(), c.num(p + "_c1"), c.num(p + "_c2"), tackle_ok);
+          }
+        }
+        status = sim.step();
+      }
+      ++out.episodes;
+      const bool same = status_name(status) == recorded;
+      out.same += same ? 1 : 0;
+      if (!same && verbose) {
+        std::printf("%s ep %s: recorded %s after %zu cycles, embedded %s\n", file.c_str(), r.str("ep").c_str(),
+                    recorded.c_str(), end - first + 1, status_name(status));
+      }
+    }
+    i = end + 1;
+  }
+  std::printf("%s: %d of %d whole episodes end as recorded (%.1f %%)\n", file.c_str(), out.same, out.episodes,
+              100.0 * out.same / std::max(1, out.episodes));
+  return out;
+}
+
+TEST(DefenderRealData, WholeEpisodesEndAsRecorded) {
+  const bool verbose = std::getenv("PAMDP_VERBOSE") != nullptr;
+  Endings all;
+  for (const auto& [file, agents, defenders] :
+       {std::tuple{"hfo-real-defense-1v2.csv", 1, 1}, std::tuple{"hfo-real-defense-2v2.csv", 2, 1},
+        std::tuple{"hfo-real-defense-1v3.csv", 1, 2}}) {
+    const Endings e = play_episodes(file, agents, defenders, verbose);
+    all.episodes += e.episodes;
+    all.same += e.same;
+  }
+  EXPECT_GE(all.episodes, 40);
+  // Issue 83's target is 90 %; today 42 of 52 (80.8 %). Nine of the ten misses are episodes the
+  // real defender ended by kicking the ball out of bounds after winning it (its chain action:
+  // dribble, hold, clear, pass), where the embedded defender, whose kick is not modelled yet,
+  // keeps the ball and captures it. The floor guards what is reached.
+  EXPECT_GE(static_cast<double>(all.same) / std::max(1, all.episodes), 0.78);
 }
 
 TEST(DefenderRealData, TheGameStepsToTheRecordedDefenderStates) {
