@@ -53,14 +53,46 @@ void print_goalie(const hfo::SoccerSim& sim, bool first) {
   std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", g.pos.x, g.pos.y, g.vel.x, g.vel.y, g.body_deg);
 }
 
-// Several offense players (STATE.json with "teammates"): the rows are player 0's, as with one,
-// and each ends with every offense player's state after the step, then the ball's.
+// A field defender's columns (agent2d's unum k + 2, numbered d1, d2 as in the recordings): the
+// command it sent in the step that produced the row, in the goalie columns' units ("on" as the
+// second parameter of a foul tackle), then its state after that step.
+void print_defender(const hfo::SoccerSim& sim, int k, bool first) {
+  const auto& c = sim.last_defender_command(k);
+  const auto kind = static_cast<hfo::GoalieCommand::Kind>(c.kind);
+  using K = hfo::GoalieCommand::Kind;
+  if (first) {
+    std::printf(",,,");
+  } else {
+    std::printf(",%s", hfo::goalie_command_name(kind));
+    if (kind == K::kNone) {
+      std::printf(",,");
+    } else if (kind == K::kDash || kind == K::kKick) {
+      std::printf(",%.9g,%.9g", c.p1, c.p2);
+    } else if (kind == K::kTackle && c.foul) {
+      std::printf(",%.9g,on", c.p1);
+    } else {
+      std::printf(",%.9g,", c.p1);
+    }
+  }
+  const hfo::PlayerState& d = sim.state().players[static_cast<size_t>(sim.defender_index(k))];
+  std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", d.pos.x, d.pos.y, d.vel.x, d.vel.y, d.body_deg);
+}
+
+// Several offense players (STATE.json with "teammates"), or field defenders ("defenders"): the
+// rows are player 0's, as with one, and each ends with every offense player's state after the
+// step, then the ball's, then each field defender's command and state.
 void run_team_trace(const TraceOptions& o, const hfo::InitialState& init) {
   hfo::SoccerSimConfig cfg = o.sim.resolved();
   cfg.offense_agents = 1 + static_cast<int>(init.teammates.size());
   if (init.has_goalie && !cfg.goalie) {
     throw std::runtime_error(o.init + ": has a \"goalie\" object but the simulator has no goalie: add --goalie");
   }
+  if (!init.defenders.empty() && !cfg.goalie) {
+    throw std::runtime_error(o.init +
+                             ": has \"defenders\" but the simulator has no goalie, which field defenders "
+                             "need (HFO's --defense-npcs counts the goalie first): add --goalie");
+  }
+  cfg.field_defenders = static_cast<int>(init.defenders.size());
   const int n = cfg.offense_agents;
   const std::vector<hfo::TeamActions> rows = hfo::load_team_actions_csv(o.actions, n);
   hfo::HfoTeamEnv env(cfg);
@@ -70,7 +102,8 @@ void run_team_trace(const TraceOptions& o, const hfo::InitialState& init) {
   env.reset(o.seed, obs);  // seeds the noise stream
   std::vector<hfo::PlayerState> offense{init.agent};
   offense.insert(offense.end(), init.teammates.begin(), init.teammates.end());
-  env.set_state(offense, init.ball, init.has_goalie ? &init.goalie : nullptr, obs);
+  env.set_state(offense, init.ball, init.has_goalie ? &init.goalie : nullptr, obs, init.defenders);
+  const int defenders = cfg.field_defenders;
 
   std::printf("step,status,reward");
   for (size_t i = 0; i < width; ++i) {
@@ -82,7 +115,11 @@ void run_team_trace(const TraceOptions& o, const hfo::InitialState& init) {
   for (int i = 0; i < n; ++i) {
     std::printf(",p%d_x,p%d_y,p%d_vx,p%d_vy,p%d_body", i, i, i, i, i);
   }
-  std::printf(",b_x,b_y,b_vx,b_vy\n");
+  std::printf(",b_x,b_y,b_vx,b_vy");
+  for (int k = 1; k <= defenders; ++k) {
+    std::printf(",d%d_cmd,d%d_p1,d%d_p2,d%d_x,d%d_y,d%d_vx,d%d_vy,d%d_body", k, k, k, k, k, k, k, k);
+  }
+  std::printf("\n");
   const hfo::SoccerSim& sim = env.sim();
   auto row = [&](int step, int status, float reward, bool first) {
     print_row(step, status, reward, std::span<const float>(obs).first(width));
@@ -94,7 +131,11 @@ void run_team_trace(const TraceOptions& o, const hfo::InitialState& init) {
       std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", p.pos.x, p.pos.y, p.vel.x, p.vel.y, p.body_deg);
     }
     const hfo::BallState& b = sim.state().ball;
-    std::printf(",%.9g,%.9g,%.9g,%.9g\n", b.pos.x, b.pos.y, b.vel.x, b.vel.y);
+    std::printf(",%.9g,%.9g,%.9g,%.9g", b.pos.x, b.pos.y, b.vel.x, b.vel.y);
+    for (int k = 0; k < defenders; ++k) {
+      print_defender(sim, k, first);
+    }
+    std::printf("\n");
   };
   row(0, hfo::kInGame, 0.0F, true);
   std::vector<ParamAction> actions(static_cast<size_t>(n));
@@ -117,7 +158,7 @@ void run_team_trace(const TraceOptions& o, const hfo::InitialState& init) {
 
 void run_trace(const TraceOptions& o) {
   const hfo::InitialState init = hfo::load_state_json(o.init);
-  if (!init.teammates.empty()) {
+  if (!init.teammates.empty() || !init.defenders.empty()) {
     run_team_trace(o, init);
     return;
   }
@@ -178,13 +219,17 @@ void register_sim(CLI::App& app) {
       "replay an action script from a given state and print step,status,reward,f0..f57 as CSV (with --goalie: "
       "f0..f65, then the goalie's command and state g_cmd,g_p1,g_p2,g_x,g_y,g_vx,g_vy,g_body; with teammates in "
       "STATE.json: player 0's reward and features, 8 more per other player, then every offense player's state "
-      "p0_x,p0_y,p0_vx,p0_vy,p0_body,p1_x,... and the ball's b_x,b_y,b_vx,b_vy)");
+      "p0_x,p0_y,p0_vx,p0_vy,p0_body,p1_x,... and the ball's b_x,b_y,b_vx,b_vy; with defenders in STATE.json (and "
+      "--goalie), the same team columns, then per field defender d1_cmd,d1_p1,d1_p2,d1_x,d1_y,d1_vx,d1_vy,d1_body, "
+      "d2_...)");
   trace
       ->add_option(
           "--init", opts->init,
           "STATE.json: {agent: {x, y, vx, vy, body_deg, stamina}, ball: {x, y, vx, vy}, "
           "teammates (optional: the other offense players, 1-3): [{x, y, vx, vy, body_deg, stamina}, ...], "
-          "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch, tackle_cycles, caught}}")
+          "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch, tackle_cycles, caught}, "
+          "defenders (optional, with --goalie: agent2d's field defenders, 1-2): [{x, y, vx, vy, body_deg, stamina, "
+          "tackle_cycles}, ...]}")
       ->required()
       ->check(existing_file("give a STATE.json (an example: tests/golden/kick_to_goal.state.json)"));
   trace

@@ -48,10 +48,12 @@ void BM_SimStepGoalie(benchmark::State& state) {
 }
 BENCHMARK(BM_SimStepGoalie);
 
-void BM_SimStepTeam(benchmark::State& state) {
+// `agents` offense agents against the goalie and `defenders` of agent2d's field defenders.
+void run_team_steps(benchmark::State& state, int agents, int defenders) {
   pamdp::hfo::SoccerSimConfig config;
   config.goalie = true;
-  config.offense_agents = static_cast<int>(state.range(0));
+  config.offense_agents = agents;
+  config.field_defenders = defenders;
   pamdp::hfo::HfoTeamEnv env(config);
   const int n = env.agents();
   std::vector<float> obs(static_cast<size_t>(n * env.observation_size()));
@@ -73,7 +75,18 @@ void BM_SimStepTeam(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
+
+void BM_SimStepTeam(benchmark::State& state) {
+  run_team_steps(state, static_cast<int>(state.range(0)), 0);
+}
 BENCHMARK(BM_SimStepTeam)->Arg(1)->Arg(2)->Arg(4);
+
+// BM_SimStepDefenders/N/K: N offense agents against HFO's --defense-npcs K (the goalie and K - 1
+// of agent2d's field defenders, issue 83).
+void BM_SimStepDefenders(benchmark::State& state) {
+  run_team_steps(state, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)) - 1);
+}
+BENCHMARK(BM_SimStepDefenders)->Args({1, 2})->Args({2, 2})->Args({1, 3});
 
 void BM_GoalStep(benchmark::State& state) {
   pamdp::goal::GoalEnv env;

@@ -81,11 +81,13 @@ TEST(HfoEnvAllocations, StepAndResetAllocateNothingWithGoalie) {
   expect_hfo_hot_path_allocation_free(true, true);
 }
 
-// 2v1 (issue 79): two offense agents, the goalie, each player's features and reward per step.
-TEST(HfoTeamEnvAllocations, StepAndResetAllocateNothing) {
+// Two offense agents and the goalie, with `field_defenders` of agent2d's field defenders beside
+// it: each player's features and reward, and every defender's decision, per step.
+void expect_team_allocation_free(int field_defenders, int min_steps) {
   hfo::SoccerSimConfig config;
   config.goalie = true;
   config.offense_agents = 2;
+  config.field_defenders = field_defenders;
   hfo::HfoTeamEnv env(config);
   const size_t n = static_cast<size_t>(env.observation_size());
   std::vector<float> obs(2 * n);
@@ -109,8 +111,18 @@ TEST(HfoTeamEnvAllocations, StepAndResetAllocateNothing) {
     }
     allocations = scope.count();
   }
-  EXPECT_GT(steps, 500);
+  EXPECT_GT(steps, min_steps);
   EXPECT_EQ(allocations, 0) << "HfoTeamEnv::step/reset allocated during " << steps << " steps";
+}
+
+// 2v1 (issue 79).
+TEST(HfoTeamEnvAllocations, StepAndResetAllocateNothing) {
+  expect_team_allocation_free(0, 500);
+}
+
+// 2v3 (issue 83): the goalie and two field defenders.
+TEST(HfoTeamEnvAllocations, StepAndResetAllocateNothingWithFieldDefenders) {
+  expect_team_allocation_free(2, 200);
 }
 
 // Plays `episodes` random episodes of `env` inside a counting scope (reset() and reset(seed)

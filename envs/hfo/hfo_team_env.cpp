@@ -61,13 +61,19 @@ void HfoTeamEnv::reset(std::span<float> obs) {
 }
 
 void HfoTeamEnv::set_state(std::span<const PlayerState> offense, const BallState& ball, const PlayerState* goalie,
-                           std::span<float> obs) {
+                           std::span<float> obs, std::span<const PlayerState> defenders) {
   if (goalie != nullptr && !sim_.config().goalie) {
     misuse("set_state() with a goalie on an env without one");
+  }
+  if (static_cast<int>(defenders.size()) > sim_.config().field_defenders) {
+    misuse("set_state() with more field defenders than the env has");
   }
   sim_.set_state(offense, ball);
   if (goalie != nullptr) {
     sim_.set_goalie(*goalie);
+  }
+  for (size_t k = 0; k < defenders.size(); ++k) {
+    sim_.set_defender(static_cast<int>(k), defenders[k]);
   }
   begin_episode(obs);
 }

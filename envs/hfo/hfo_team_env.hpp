@@ -42,9 +42,10 @@ class HfoTeamEnv final : public Env {
   void reset(std::span<float> obs) override;
   void set_training_updates(int64_t updates) override { sim_.set_training_updates(updates); }
   // Starts an episode from an explicit state (tests, `pamdp sim trace`): one state per offense
-  // player; `goalie` (may be null) replaces the goalie's start on an env with a goalie.
+  // player; `goalie` (may be null) replaces the goalie's start on an env with a goalie, and
+  // `defenders` the first field defenders' (at most SoccerSimConfig::field_defenders).
   void set_state(std::span<const PlayerState> offense, const BallState& ball, const PlayerState* goalie,
-                 std::span<float> obs);
+                 std::span<float> obs, std::span<const PlayerState> defenders = {});
   // One cycle: every player's action (agents() of them, in player order), then the server's
   // cycle. Returns the episode status (kInGame while it goes on); calling it after a terminal
   // status without a reset stops the process.

@@ -136,7 +136,7 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       !j["ball"].is_object()) {
     throw std::runtime_error(src + ": expected an object with \"agent\" and \"ball\" objects");
   }
-  reject_unknown(j, "", {"agent", "ball", "teammates", "goalie"}, src);
+  reject_unknown(j, "", {"agent", "ball", "teammates", "goalie", "defenders"}, src);
   const auto& b = j["ball"];
   reject_unknown(b, "ball", {"x", "y", "vx", "vy"}, src);
   InitialState s;
@@ -188,6 +188,37 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
         throw std::runtime_error(src + ": goalie.caught must be true or false");
       }
       s.goalie.caught = g["caught"].get<bool>();
+    }
+  }
+  if (j.contains("defenders")) {
+    const auto& ds = j["defenders"];
+    if (!ds.is_array() || ds.size() > static_cast<size_t>(kMaxFieldDefenders)) {
+      throw std::runtime_error(src + ": \"defenders\" must be an array of at most " +
+                               std::to_string(kMaxFieldDefenders) +
+                               " objects (agent2d's field defenders, unums 2 and 3)");
+    }
+    for (size_t i = 0; i < ds.size(); ++i) {
+      const std::string group = "defenders[" + std::to_string(i) + "]";
+      const char* g = group.c_str();
+      if (!ds[i].is_object()) {
+        throw std::runtime_error(src + ": \"" + group + "\" must be an object");
+      }
+      reject_unknown(ds[i], g, {"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles"}, src);
+      PlayerState d;
+      d.pos = {number(ds[i], g, "x", src, {}), number(ds[i], g, "y", src, {})};
+      d.vel = {number(ds[i], g, "vx", src, 0.0), number(ds[i], g, "vy", src, 0.0)};
+      d.body_deg = number(ds[i], g, "body_deg", src, kGoalieStartBodyDeg);
+      d.stamina = number(ds[i], g, "stamina", src, kStaminaMax);
+      if (d.stamina < 0.0 || d.stamina > kStaminaMax) {
+        throw std::runtime_error(src + ": " + group + ".stamina must be within [0, 8000]");
+      }
+      const double frozen = number(ds[i], g, "tackle_cycles", src, 0.0);
+      if (frozen < 0.0 || frozen > kTackleCycles || frozen != std::floor(frozen)) {
+        throw std::runtime_error(src + ": " + group + ".tackle_cycles must be a whole number of cycles within [0, " +
+                                 std::to_string(kTackleCycles) + "]");
+      }
+      d.tackle_cycles = static_cast<int>(frozen);
+      s.defenders.push_back(d);
     }
   }
   return s;

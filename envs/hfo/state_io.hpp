@@ -11,6 +11,10 @@
 // body 180, stamina 8000, no catch yet, not frozen); since_catch counts the cycles since its last
 // catch command, tackle_cycles the cycles its own tackle still freezes it (0-10), and caught says
 // it caught the ball earlier in the episode (it then only keeps its position until the reset).
+// "defenders" is optional (with "goalie" or --goalie): agent2d's field defenders, unums 2 and 3,
+// [{"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles"}, ...], at most 2; each key
+// missing takes 0 (velocities, tackle_cycles), 180 (body_deg) or 8000 (stamina); x and y are
+// required.
 // ACTIONS.csv: one action per row: DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir;
 // blank lines and lines starting with '#' are skipped. With several offense players a row holds
 // one action per player, in player order, separated by '|': DASH,80,0|KICK,60,-20.
@@ -30,7 +34,8 @@ struct InitialState {
   BallState ball;
   std::vector<PlayerState> teammates;  // offense players 1, 2, ...
   bool has_goalie = false;
-  PlayerState goalie;  // when has_goalie
+  PlayerState goalie;                  // when has_goalie
+  std::vector<PlayerState> defenders;  // agent2d's field defenders (unums 2, 3), with the goalie
 };
 
 InitialState parse_state_json(const std::string& text, const std::string& source_name);
