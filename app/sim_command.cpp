@@ -30,34 +30,11 @@ void print_row(int step, int status, float reward, std::span<const float> obs) {
   }
 }
 
-// The goalie's columns: the command it sent in the step that produced the row (in the
+// A defense player's columns: the command it sent in the step that produced the row (in the
 // server's units, as the real server's logs give them; empty on the first row and where a
-// command has no such parameter), then its state after that step.
-void print_goalie(const hfo::SoccerSim& sim, bool first) {
-  const auto& c = sim.last_goalie_command();
-  const auto kind = static_cast<hfo::GoalieCommand::Kind>(c.kind);
-  using K = hfo::GoalieCommand::Kind;
-  if (first) {
-    std::printf(",,,");
-  } else {
-    std::printf(",%s", hfo::goalie_command_name(kind));
-    if (kind == K::kNone) {
-      std::printf(",,");
-    } else if (kind == K::kDash || kind == K::kKick) {
-      std::printf(",%.9g,%.9g", c.p1, c.p2);
-    } else {
-      std::printf(",%.9g,", c.p1);
-    }
-  }
-  const hfo::PlayerState& g = sim.state().players[static_cast<size_t>(sim.goalie_index())];
-  std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", g.pos.x, g.pos.y, g.vel.x, g.vel.y, g.body_deg);
-}
-
-// A field defender's columns (agent2d's unum k + 2, numbered d1, d2 as in the recordings): the
-// command it sent in the step that produced the row, in the goalie columns' units ("on" as the
-// second parameter of a foul tackle), then its state after that step.
-void print_defender(const hfo::SoccerSim& sim, int k, bool first) {
-  const auto& c = sim.last_defender_command(k);
+// command has no such parameter; "on" as the second parameter of a foul tackle), then its state
+// after that step.
+void print_npc(const hfo::SoccerSim::GoalieCommandLog& c, const hfo::PlayerState& p, bool first) {
   const auto kind = static_cast<hfo::GoalieCommand::Kind>(c.kind);
   using K = hfo::GoalieCommand::Kind;
   if (first) {
@@ -74,8 +51,17 @@ void print_defender(const hfo::SoccerSim& sim, int k, bool first) {
       std::printf(",%.9g,", c.p1);
     }
   }
-  const hfo::PlayerState& d = sim.state().players[static_cast<size_t>(sim.defender_index(k))];
-  std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", d.pos.x, d.pos.y, d.vel.x, d.vel.y, d.body_deg);
+  std::printf(",%.9g,%.9g,%.9g,%.9g,%.9g", p.pos.x, p.pos.y, p.vel.x, p.vel.y, p.body_deg);
+}
+
+// The goalie's columns (g_cmd ... g_body).
+void print_goalie(const hfo::SoccerSim& sim, bool first) {
+  print_npc(sim.last_goalie_command(), sim.state().players[static_cast<size_t>(sim.goalie_index())], first);
+}
+
+// Field defender k's columns (agent2d's unum k + 2, numbered d1, d2 as in the recordings).
+void print_defender(const hfo::SoccerSim& sim, int k, bool first) {
+  print_npc(sim.last_defender_command(k), sim.state().players[static_cast<size_t>(sim.defender_index(k))], first);
 }
 
 // Several offense players (STATE.json with "teammates"), or field defenders ("defenders"): the

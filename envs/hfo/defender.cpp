@@ -12,24 +12,9 @@ namespace {
 using agent2d::Command;
 using agent2d::GoalieWorld;
 using agent2d::InterceptTable;
-using agent2d::PlayerView;
 
 Vec2 mirror(Vec2 v) {
   return {-v.x, -v.y};
-}
-
-// Sorts players nearest to the ball first (WorldModel::teammatesFromBall / opponentsFromBall).
-template <size_t N>
-void sort_from_ball(std::array<PlayerView, N>& players, int n, Vec2 ball) {
-  for (int i = 1; i < n; ++i) {
-    const PlayerView p = players[static_cast<size_t>(i)];
-    const double d = (p.pos - ball).r2();
-    int j = i;
-    for (; j > 0 && (players[static_cast<size_t>(j - 1)].pos - ball).r2() > d; --j) {
-      players[static_cast<size_t>(j)] = players[static_cast<size_t>(j - 1)];
-    }
-    players[static_cast<size_t>(j)] = p;
-  }
 }
 
 // Line through p along `deg`, met with the goal line: Ray2D::intersection in Bhv_BasicTackle.
@@ -114,43 +99,7 @@ double normal_dash_power(const GoalieWorld& w, const InterceptTable& t) {
 }  // namespace
 
 GoalieWorld defender_world(const SoccerState& s, int defender, bool server_noise) {
-  const PlayerState& me = s.players[static_cast<size_t>(defender)];
-  GoalieWorld w;
-  w.self.pos = mirror(me.pos);
-  w.self.vel = mirror(me.vel);
-  w.self.body_deg = agent2d::angle_norm(me.body_deg + 180.0);
-  w.self.stamina = me.stamina;
-  w.self.effort = me.effort;
-  w.self.recovery = me.recovery;
-  w.self.capacity = me.capacity;
-  w.self.frozen = me.tackle_cycles > 0;
-  w.self.goalie = false;
-  w.ball_pos = mirror(s.ball.pos);
-  w.ball_vel = mirror(s.ball.vel);
-  w.player_rand = server_noise ? kPlayerRand : 0.0;
-  w.ball_rand = server_noise ? kBallRand : 0.0;
-  for (int i = 0; i < s.num_players; ++i) {
-    if (i == defender) {
-      continue;
-    }
-    const PlayerState& p = s.players[static_cast<size_t>(i)];
-    PlayerView v;
-    v.pos = mirror(p.pos);
-    v.vel = mirror(p.vel);
-    v.body_deg = agent2d::angle_norm(p.body_deg + 180.0);
-    v.tackling = p.tackle_cycles > 0;
-    v.goalie = p.goalie;
-    if (p.team == me.team) {
-      if (w.num_teammates < GoalieWorld::kMaxTeammates) {
-        w.teammates[static_cast<size_t>(w.num_teammates++)] = v;
-      }
-    } else if (w.num_opponents < GoalieWorld::kMaxOpponents) {
-      w.opponents[static_cast<size_t>(w.num_opponents++)] = v;
-    }
-  }
-  sort_from_ball(w.teammates, w.num_teammates, w.ball_pos);
-  sort_from_ball(w.opponents, w.num_opponents, w.ball_pos);
-  w.finish();
+  GoalieWorld w = defense_world(s, defender, server_noise);
   if (w.exist_kickable_opponent && !w.self_kickable) {
     w.ball_vel = {};  // BallObject::setOpponentControlEffect
   }

@@ -727,10 +727,19 @@ double tackle_generator_angle(const agent2d::GoalieWorld& w) {
   return best_tackle_angle(w);
 }
 
-agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_noise) {
+agent2d::GoalieWorld defense_world(const SoccerState& s, int self, bool server_noise) {
   // rcssserver sends the right side every position mirrored through the centre.
   auto mirror = [](Vec2 v) { return Vec2{-v.x, -v.y}; };
-  const PlayerState& me = s.players[goalie];
+  auto view = [&](const PlayerState& p) {
+    agent2d::PlayerView v;
+    v.pos = mirror(p.pos);
+    v.vel = mirror(p.vel);
+    v.body_deg = angle_norm(p.body_deg + 180.0);
+    v.tackling = p.tackle_cycles > 0;
+    v.goalie = p.goalie;
+    return v;
+  };
+  const PlayerState& me = s.players[self];
   GoalieWorld w;
   w.self.pos = mirror(me.pos);
   w.self.vel = mirror(me.vel);
@@ -740,53 +749,36 @@ agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_
   w.self.recovery = me.recovery;
   w.self.capacity = me.capacity;
   w.self.frozen = me.tackle_cycles > 0;
+  w.self.goalie = me.goalie;
   w.ball_pos = mirror(s.ball.pos);
   w.ball_vel = mirror(s.ball.vel);
-  w.since_catch = me.since_catch;
-  w.catch_mode = me.caught;
   w.player_rand = server_noise ? kPlayerRand : 0.0;
   w.ball_rand = server_noise ? kBallRand : 0.0;
   for (int i = 0; i < s.num_players; ++i) {
     const PlayerState& p = s.players[i];
-    if (i != goalie && p.team == me.team && w.num_teammates < GoalieWorld::kMaxTeammates) {
-      // agent2d's field defenders: the goalie's teammates in its intercept table.
-      agent2d::PlayerView& t = w.teammates[w.num_teammates++];
-      t.pos = mirror(p.pos);
-      t.vel = mirror(p.vel);
-      t.body_deg = angle_norm(p.body_deg + 180.0);
-      t.tackling = p.tackle_cycles > 0;
+    if (i == self) {
       continue;
     }
-    if (p.team == me.team || w.num_opponents == GoalieWorld::kMaxOpponents) {
-      continue;
+    if (p.team == me.team) {
+      if (w.num_teammates < GoalieWorld::kMaxTeammates) {
+        w.teammates[w.num_teammates++] = view(p);
+      }
+    } else if (w.num_opponents < GoalieWorld::kMaxOpponents) {
+      w.opponents[w.num_opponents++] = view(p);
     }
-    agent2d::PlayerView& o = w.opponents[w.num_opponents++];
-    o.pos = mirror(p.pos);
-    o.vel = mirror(p.vel);
-    o.body_deg = angle_norm(p.body_deg + 180.0);
-    o.tackling = p.tackle_cycles > 0;
   }
-  // Nearest to the ball first (WorldModel::opponentsFromBall); an insertion sort of at most
-  // kMaxOpponents entries.
-  for (int i = 1; i < w.num_opponents; ++i) {
-    const agent2d::PlayerView o = w.opponents[i];
-    const double d = (o.pos - w.ball_pos).r2();
-    int j = i;
-    for (; j > 0 && (w.opponents[j - 1].pos - w.ball_pos).r2() > d; --j) {
-      w.opponents[j] = w.opponents[j - 1];
-    }
-    w.opponents[j] = o;
-  }
-  for (int i = 1; i < w.num_teammates; ++i) {
-    const agent2d::PlayerView t = w.teammates[i];
-    const double d = (t.pos - w.ball_pos).r2();
-    int j = i;
-    for (; j > 0 && (w.teammates[j - 1].pos - w.ball_pos).r2() > d; --j) {
-      w.teammates[j] = w.teammates[j - 1];
-    }
-    w.teammates[j] = t;
-  }
+  // Nearest to the ball first (WorldModel::teammatesFromBall, opponentsFromBall).
+  agent2d::sort_from_ball(std::span(w.teammates).first(static_cast<size_t>(w.num_teammates)), w.ball_pos);
+  agent2d::sort_from_ball(std::span(w.opponents).first(static_cast<size_t>(w.num_opponents)), w.ball_pos);
   w.finish();
+  return w;
+}
+
+agent2d::GoalieWorld goalie_world(const SoccerState& s, int goalie, bool server_noise) {
+  GoalieWorld w = defense_world(s, goalie, server_noise);
+  const PlayerState& me = s.players[goalie];
+  w.since_catch = me.since_catch;
+  w.catch_mode = me.caught;
   return w;
 }
 

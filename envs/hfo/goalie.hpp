@@ -41,6 +41,11 @@ using GoalieCommand = agent2d::Command;
 // them at 0, which the goalie reads from the server as the real one does.
 agent2d::GoalieWorld goalie_world(const SoccerState& state, int goalie, bool server_noise);
 
+// The world model of defense player `self` (the goalie or a field defender) as librcsc builds it
+// from full state, mirrored into its frame: itself, the ball, its teammates and its opponents,
+// each group nearest to the ball first. goalie_world adds the goalie's catch memory.
+agent2d::GoalieWorld defense_world(const SoccerState& state, int self, bool server_noise);
+
 // The goalie's command for this cycle; `goalie` indexes state.players.
 GoalieCommand decide_goalie(const SoccerState& state, int goalie, bool server_noise);
 

@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 
 #include "envs/hfo/geometry.hpp"
 
@@ -82,6 +83,20 @@ struct SelfView {
   // control area in its own intercept is always the kickable area (goalie_self_intercept.cpp).
   bool goalie = true;
 };
+
+// Sorts players nearest to `ball` first, the earlier first among equals (WorldModel's
+// teammatesFromBall / opponentsFromBall): an insertion sort of a few entries.
+inline void sort_from_ball(std::span<PlayerView> players, Vec2 ball) {
+  for (size_t i = 1; i < players.size(); ++i) {
+    const PlayerView p = players[i];
+    const double d = (p.pos - ball).r2();
+    size_t j = i;
+    for (; j > 0 && (players[j - 1].pos - ball).r2() > d; --j) {
+      players[j] = players[j - 1];
+    }
+    players[j] = p;
+  }
+}
 
 // librcsc WorldModel, reduced to what the goalie reads, in the goalie's frame.
 struct GoalieWorld {
