@@ -49,6 +49,51 @@ const char* kind_name(agent2d::Command::Kind k) {
   return "";
 }
 
+// The embedded game at a recorded row: the attackers (frozen as recorded), the goalie and the
+// field defenders (a defender without a command is frozen by its tackle), the ball; noise off.
+SoccerSim game_at(const CsvRow& r, int agents, int field_defenders) {
+  SoccerSimConfig cfg;
+  cfg.noise = false;
+  cfg.offense_agents = agents;
+  cfg.goalie = true;
+  cfg.field_defenders = field_defenders;
+  SoccerSim sim(cfg, 1);
+  std::vector<PlayerState> offense;
+  for (int a = 0; a < agents; ++a) {
+    PlayerState p = player_at(r, "p" + std::to_string(a), true);
+    p.tackle_cycles = static_cast<int>(r.num("p" + std::to_string(a) + "_frozen"));
+    offense.push_back(p);
+  }
+  sim.set_state(offense, BallState{{r.num("bx"), r.num("by")}, {r.num("bvx"), r.num("bvy")}});
+  PlayerState g = player_at(r, "g", true);
+  g.tackle_cycles = static_cast<int>(r.num("g_frozen"));
+  sim.set_goalie(g);
+  for (int k = 0; k < field_defenders; ++k) {
+    const std::string d = "d" + std::to_string(k + 1);
+    PlayerState p = player_at(r, d, false);
+    const std::string cmd = r.str(d + "_cmd");
+    p.tackle_cycles = cmd.empty() || cmd == "NONE" ? 1 : 0;
+    sim.set_defender(k, p);
+  }
+  return sim;
+}
+
+// Sends every attacker's recorded command of row `r` (a tackle's outcome from row `next`'s flags).
+void send_attackers(SoccerSim& sim, const CsvRow& r, const CsvRow* next, int agents) {
+  for (int a = 0; a < agents; ++a) {
+    const std::string p = "p" + std::to_string(a);
+    const std::string cmd = r.str(p + "_cmd");
+    if (cmd.empty()) {
+      continue;
+    }
+    std::optional<bool> tackle_ok;
+    if (cmd == "TACKLE" && next != nullptr) {
+      tackle_ok = (std::stol(next->str(p + "_state"), nullptr, 16) & 0x1000) != 0;
+    }
+    sim.command_as_received(a, cmd.c_str(), r.num(p + "_c1"), r.num(p + "_c2"), tackle_ok);
+  }
+}
+
 // The .dcl label's rule, in DefenderDecision's terms.
 const char* rule_of_label(const std::string& label) {
   if (label.rfind("BasicMove", 0) == 0) {
@@ -181,40 +226,8 @@ Stepped step_game(const std::string& file, int agents, int field_defenders, bool
     if (r.str("status") != "IN_GAME" || n.str("src") != r.str("src") || n.str("ep") != r.str("ep") || r.num("t") < 2) {
       continue;  // the reset cycles and the last row of an episode
     }
-    SoccerSimConfig cfg;
-    cfg.noise = false;
-    cfg.offense_agents = agents;
-    cfg.goalie = true;
-    cfg.field_defenders = field_defenders;
-    SoccerSim sim(cfg, 1);
-    std::vector<PlayerState> offense;
-    for (int a = 0; a < agents; ++a) {
-      PlayerState p = player_at(r, "p" + std::to_string(a), true);
-      p.tackle_cycles = static_cast<int>(r.num("p" + std::to_string(a) + "_frozen"));
-      offense.push_back(p);
-    }
-    sim.set_state(offense, BallState{{r.num("bx"), r.num("by")}, {r.num("bvx"), r.num("bvy")}});
-    PlayerState g = player_at(r, "g", true);
-    g.tackle_cycles = static_cast<int>(r.num("g_frozen"));
-    sim.set_goalie(g);
-    for (int k = 0; k < field_defenders; ++k) {
-      const std::string d = "d" + std::to_string(k + 1);
-      PlayerState p = player_at(r, d, false);
-      const std::string cmd = r.str(d + "_cmd");
-      p.tackle_cycles = cmd.empty() || cmd == "NONE" ? 1 : 0;
-      sim.set_defender(k, p);
-    }
-    for (int a = 0; a < agents; ++a) {
-      const std::string p = "p" + std::to_string(a);
-      const std::string cmd = r.str(p + "_cmd");
-      std::optional<bool> tackle_ok;
-      if (cmd == "TACKLE") {
-        tackle_ok = (std::stol(n.str(p + "_state"), nullptr, 16) & 0x1000) != 0;
-      }
-      if (!cmd.empty()) {
-        sim.command_as_received(a, cmd.c_str(), r.num(p + "_c1"), r.num(p + "_c2"), tackle_ok);
-      }
-    }
+    SoccerSim sim = game_at(r, agents, field_defenders);
+    send_attackers(sim, r, &n, agents);
     sim.step();
     ++out.rows;
     const SoccerState& s = sim.state();
@@ -283,38 +296,13 @@ Endings play_episodes(const std::string& file, int agents, int field_defenders, 
     }
     if (first <= end && recorded != "IN_GAME" && rows[first].str("status") == "IN_GAME") {
       const CsvRow& r = rows[first];
-      SoccerSimConfig cfg;
-      cfg.noise = false;
-      cfg.offense_agents = agents;
-      cfg.goalie = true;
-      cfg.field_defenders = field_defenders;
-      SoccerSim sim(cfg, 1);
-      std::vector<PlayerState> offense;
-      for (int a = 0; a < agents; ++a) {
-        offense.push_back(player_at(r, "p" + std::to_string(a), true));
-      }
-      sim.set_state(offense, BallState{{r.num("bx"), r.num("by")}, {r.num("bvx"), r.num("bvy")}});
-      sim.set_goalie(player_at(r, "g", true));
-      for (int k = 0; k < field_defenders; ++k) {
-        sim.set_defender(k, player_at(r, "d" + std::to_string(k + 1), false));
-      }
+      SoccerSim sim = game_at(r, agents, field_defenders);
       // The referee's counters at this state: the ball untouched since the reset, nobody held.
       sim.mutable_state().cycle = static_cast<int>(r.num("t"));
       sim.mutable_state().untouched = static_cast<int>(r.num("t"));
       int status = kInGame;
       for (size_t k = first; k <= end && status == kInGame; ++k) {
-        const CsvRow& c = rows[k];
-        for (int a = 0; a < agents; ++a) {
-          const std::string p = "p" + std::to_string(a);
-          const std::string cmd = c.str(p + "_cmd");
-          if (!cmd.empty()) {
-            std::optional<bool> tackle_ok;
-            if (cmd == "TACKLE" && k + 1 <= end) {
-              tackle_ok = (std::stol(rows[k + 1].str(p + "_state"), nullptr, 16) & 0x1000) != 0;
-            }
-            sim.command_as_received(a, cmd.c_str(), c.num(p + "_c1"), c.num(p + "_c2"), tackle_ok);
-          }
-        }
+        send_attackers(sim, rows[k], k + 1 <= end ? &rows[k + 1] : nullptr, agents);
         status = sim.step();
       }
       ++out.episodes;
