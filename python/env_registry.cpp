@@ -16,11 +16,11 @@ struct Entry {
   std::vector<std::string> options;  // the env.* keys a user may set
 };
 
-// The keys env `name` reads (envs/registry.hpp), less `fixed_key`.
-std::vector<std::string> options_of(const std::string& name, const std::string& fixed_key = "") {
+// The keys env `name` reads (envs/registry.hpp), less `fixed_keys`.
+std::vector<std::string> options_of(const std::string& name, const std::vector<std::string>& fixed_keys = {}) {
   std::vector<std::string> out;
   for (const EnvKey& k : env_registry().find(name).keys) {
-    if (k.name != fixed_key) {
+    if (std::find(fixed_keys.begin(), fixed_keys.end(), k.name) == fixed_keys.end()) {
       out.push_back(k.name);
     }
   }
@@ -34,12 +34,12 @@ const std::vector<Entry>& entries() {
     std::vector<Entry> e{
         {{"hfo-1v0", "embedded Half Field Offense, the agent alone against an empty goal (58 features)"},
          "hfo",
-         {"goalie=false"},
-         options_of("hfo", "goalie")},
+         {"goalie=false", "defense_npcs=0"},
+         options_of("hfo", {"goalie", "defense_npcs"})},
         {{"hfo-1v1", "embedded Half Field Offense against the NPC goalie (66 features)"},
          "hfo",
-         {"goalie=true"},
-         options_of("hfo", "goalie")},
+         {"goalie=true", "defense_npcs=0"},
+         options_of("hfo", {"goalie", "defense_npcs"})},
     };
     for (const EnvRegistration& r : env_registry().all()) {
       e.push_back({{r.name, r.description}, r.name, {}, options_of(r.name)});
@@ -100,8 +100,8 @@ app::EnvConfig resolve_env(const std::string& id, const std::vector<std::pair<st
     if (std::find(e.options.begin(), e.options.end(), key) == e.options.end()) {
       for (const std::string& f : e.fixed) {
         if (f.rfind(key + "=", 0) == 0) {
-          throw std::invalid_argument(source + ": '" + key + "' is fixed by the id ('" + f +
-                                      "'); make('hfo', goalie=...) chooses it");
+          throw std::invalid_argument(source + ": '" + key + "' is fixed by the id ('" + f + "'); make('hfo', " + key +
+                                      "=...) chooses it");
         }
       }
       throw std::invalid_argument(source + ": unknown option '" + key + "' (valid: " + join(option_names(id)) + ")");
@@ -127,10 +127,29 @@ std::unique_ptr<Env> build_env(const app::EnvConfig& config, bool team) {
 }
 
 std::string id_of(const app::EnvConfig& config) {
-  // The goalie picks between the ids that name env 'hfo' with the goalie fixed.
-  const std::string fixed = config.params.boolean("goalie") ? "goalie=true" : "goalie=false";
+  // The id whose fixed assignments the config holds (the goalie picks between hfo-1v0 and
+  // hfo-1v1, both without field defenders); else the env's name.
   for (const Entry& e : entries()) {
-    if (e.name == config.name && e.fixed.size() == 1 && e.fixed.front() == fixed) {
+    if (e.name != config.name || e.fixed.empty()) {
+      continue;
+    }
+    const bool all = std::all_of(e.fixed.begin(), e.fixed.end(), [&](const std::string& f) {
+      const auto eq = f.find('=');
+      const std::string key = f.substr(0, eq);
+      if (!config.params.contains(key)) {
+        return false;
+      }
+      const EnvValue& v = config.params.values().at(key);
+      const std::string value = f.substr(eq + 1);
+      if (const auto* b = std::get_if<bool>(&v)) {
+        return (*b ? "true" : "false") == value;
+      }
+      if (const auto* i = std::get_if<int64_t>(&v)) {
+        return std::to_string(*i) == value;
+      }
+      return false;
+    });
+    if (all) {
       return e.id.id;
     }
   }

@@ -221,6 +221,8 @@ class CallerErrors(unittest.TestCase):
         self.assertRaisesWith(ValueError, "unknown option 'nosie' (valid: body_at_reset, max_steps, noise",
                               pamdp.make, "hfo-1v0", nosie=False)
         self.assertRaisesWith(ValueError, "'goalie' is fixed", pamdp.make, "hfo-1v0", goalie=True)
+        self.assertRaisesWith(ValueError, "'defense_npcs' is fixed by the id ('defense_npcs=0'); make('hfo', "
+                              "defense_npcs=...) chooses it", pamdp.make, "hfo-1v1", defense_npcs=2)
         self.assertRaisesWith(ValueError, "unknown option 'noise' (valid: none)", pamdp.make, "reach_stop",
                               noise=False)
         self.assertRaisesWith(ValueError, "'env.start' must be one of: paper, dec2015, hfo", pamdp.make, "hfo-1v0",
