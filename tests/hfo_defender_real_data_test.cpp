@@ -105,9 +105,21 @@ const char* rule_of_label(const std::string& label) {
   if (label.rfind("BasicFoul", 0) == 0 || label.rfind("BasicTackle", 0) == 0) {
     return "tackle";
   }
-  // hold, dribble, pass, clear: the chain action with the ball kickable, and the dribble's
+  if (label.find("dribble|SelfPass") != std::string::npos) {
+    return "self-pass";  // the chain action's self-pass, fresh or after a cancelled dribble
+  }
+  // hold, short dribble, pass, clear: the chain action with the ball kickable, and the dribble's
   // queued intention (NormalDribble…) in the cycles after it.
   return "kick";
+}
+
+// The recordings in tests/data, or the full ones behind them: PAMDP_DEFENSE_DATA_DIR names a
+// folder holding files of the same names (tools/hfo-record's cycles.csv of each setting, joined).
+std::string data_path(const std::string& file) {
+  if (const char* dir = std::getenv("PAMDP_DEFENSE_DATA_DIR")) {
+    return std::string(dir) + "/" + file;
+  }
+  return std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file;
 }
 
 const char* rule_name(DefenderDecision::Rule r) {
@@ -116,6 +128,7 @@ const char* rule_name(DefenderDecision::Rule r) {
     case DefenderDecision::Rule::kIntercept: return "intercept";
     case DefenderDecision::Rule::kTackle: return "tackle";
     case DefenderDecision::Rule::kKick: return "kick";
+    case DefenderDecision::Rule::kSelfPass: return "self-pass";
     case DefenderDecision::Rule::kFrozen: break;
   }
   return "frozen";
@@ -128,10 +141,16 @@ struct Tally {
   int rule = 0;
   int move_rows = 0;
   int target = 0;
+  int force_kicks = 0;  // SamplePlayer::doForceKick's kicks, their power and direction checked
+  int force_kicks_ok = 0;
+  int self_passes = 0;  // the chain action's self-pass kicks, their power and direction checked
+  int self_passes_ok = 0;
+  int chain_kicks = 0;  // every chain-action kick, and those where the choice (self-pass or not) matches
+  int chain_kicks_same_rule = 0;
 };
 
 Tally replay(const std::string& file, int agents, int field_defenders, bool verbose) {
-  const std::vector<CsvRow> rows = testing::load_csv_rows(std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file);
+  const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   EXPECT_FALSE(rows.empty()) << file;
   Tally t;
   int shown = 0;
@@ -166,11 +185,28 @@ Tally replay(const std::string& file, int agents, int field_defenders, bool verb
       ++t.cycles;
       const bool kind_ok = cmd == kind_name(dec.command.kind);
       t.kind += kind_ok ? 1 : 0;
-      const bool params_ok =
-          kind_ok && (cmd == "KICK" || (std::fabs(dec.command.p1 - r.num(d + "_c1")) < 0.1 &&
-                                        (cmd != "DASH" || std::fabs(dec.command.p2 - r.num(d + "_c2")) < 0.1)));
-      t.command += params_ok ? 1 : 0;
       const std::string label = r.str(d + "_label");
+      // A kick's parameters are checked where they are modelled: the simultaneous kick and the
+      // self-pass, not the hold's or the other chain actions'.
+      const bool self_pass = std::string(rule_of_label(label)) == "self-pass";
+      const bool params_checked = cmd != "KICK" || label.rfind("SimultaneousKick", 0) == 0 || self_pass;
+      const bool params_ok =
+          kind_ok && (!params_checked ||
+                      (std::fabs(dec.command.p1 - r.num(d + "_c1")) < 0.1 &&
+                       (cmd == "TURN" || cmd == "TACKLE" || std::fabs(dec.command.p2 - r.num(d + "_c2")) < 0.1)));
+      t.command += params_ok ? 1 : 0;
+      if (label.rfind("SimultaneousKick", 0) == 0) {
+        ++t.force_kicks;
+        t.force_kicks_ok += params_ok ? 1 : 0;
+      }
+      if (self_pass) {
+        ++t.self_passes;
+        t.self_passes_ok += params_ok ? 1 : 0;
+      }
+      if (cmd == "KICK" && label.rfind("SimultaneousKick", 0) != 0) {
+        ++t.chain_kicks;
+        t.chain_kicks_same_rule += std::string(rule_of_label(label)) == rule_name(dec.rule) ? 1 : 0;
+      }
       const bool rule_ok = std::string(rule_of_label(label)) == rule_name(dec.rule);
       t.rule += rule_ok ? 1 : 0;
       if (label.rfind("BasicMove", 0) == 0 && dec.rule == DefenderDecision::Rule::kBasicMove) {
@@ -190,9 +226,11 @@ Tally replay(const std::string& file, int agents, int field_defenders, bool verb
   }
   std::printf(
       "%s: %d defender cycles; command kind %.1f %%, command %.1f %%, rule %.1f %%, home position within 1 cm %.1f "
-      "%% of %d\n",
+      "%% of %d; simultaneous kicks with their power and direction %d of %d; self-passes %d of %d; chain action "
+      "chosen %d of %d\n",
       file.c_str(), t.cycles, 100.0 * t.kind / std::max(1, t.cycles), 100.0 * t.command / std::max(1, t.cycles),
-      100.0 * t.rule / std::max(1, t.cycles), 100.0 * t.target / std::max(1, t.move_rows), t.move_rows);
+      100.0 * t.rule / std::max(1, t.cycles), 100.0 * t.target / std::max(1, t.move_rows), t.move_rows,
+      t.force_kicks_ok, t.force_kicks, t.self_passes_ok, t.self_passes, t.chain_kicks_same_rule, t.chain_kicks);
   return t;
 }
 
@@ -203,6 +241,7 @@ void expect_agreement(const Tally& t) {
   EXPECT_GE(t.command / n, 0.985);
   EXPECT_GE(t.rule / n, 0.98);
   EXPECT_GE(static_cast<double>(t.target) / std::max(1, t.move_rows), 0.985);
+  EXPECT_EQ(t.force_kicks_ok, t.force_kicks);  // librcsc's Body_KickOneStep, to 0.1 in power and direction
 }
 
 // The embedded game stepped from each recorded state: the attackers send their recorded
@@ -217,7 +256,7 @@ struct Stepped {
 };
 
 Stepped step_game(const std::string& file, int agents, int field_defenders, bool verbose) {
-  const std::vector<CsvRow> rows = testing::load_csv_rows(std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file);
+  const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   Stepped out;
   int shown = 0;
   for (size_t i = 0; i + 1 < rows.size(); ++i) {
@@ -280,7 +319,7 @@ struct Endings {
 };
 
 Endings play_episodes(const std::string& file, int agents, int field_defenders, bool verbose) {
-  const std::vector<CsvRow> rows = testing::load_csv_rows(std::string(PAMDP_TEST_DATA_DIR) + "/data/" + file);
+  const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   Endings out;
   size_t i = 0;
   while (i < rows.size()) {
@@ -331,11 +370,12 @@ TEST(DefenderRealData, WholeEpisodesEndAsRecorded) {
     all.same += e.same;
   }
   EXPECT_GE(all.episodes, 40);
-  // Issue 83's target is 90 %; today 42 of 52 (80.8 %). Nine of the ten misses are episodes the
-  // real defender ended by kicking the ball out of bounds after winning it (its chain action:
-  // dribble, hold, clear, pass), where the embedded defender, whose kick is not modelled yet,
-  // keeps the ball and captures it. The floor guards what is reached.
-  EXPECT_GE(static_cast<double>(all.same) / std::max(1, all.episodes), 0.78);
+  // Issue 83's target is 90 %: 48 of 52 (92.3 %) here, and 756 of 891 (84.8 %) over the full
+  // recordings behind this subset (PAMDP_DEFENSE_DATA_DIR). Most misses on the full recordings are
+  // a real defender's chain action after winning the ball (a self-pass toward the half-way line,
+  // out of HFO's field), where the embedded defender keeps the ball and captures it; the chain
+  // action is not modelled. The floor guards what is reached.
+  EXPECT_GE(static_cast<double>(all.same) / std::max(1, all.episodes), 0.90);
 }
 
 TEST(DefenderRealData, TheGameStepsToTheRecordedDefenderStates) {

@@ -4,13 +4,18 @@
 // d222758), re-implemented from its rules on the goalie's world model and librcsc actions
 // (goalie_world.hpp; the intercept with SelfView::goalie false).
 //
-// decide_defender() is a pure function of the state at the start of a cycle. Not yet in the
-// simulator: it is checked one recorded cycle at a time against the real server's defenders
-// (tests/hfo_defender_real_data_test.cpp). What it does each cycle:
+// decide_defender() is a pure function of the state at the start of a cycle; the simulator
+// plays it for env.defense_npcs >= 2, and it is checked one recorded cycle at a time against the
+// real server's defenders (tests/hfo_defender_real_data_test.cpp). What it does each cycle:
 //  - frozen by its own tackle: no body command;
-//  - the ball kickable (no teammate nearer to it): a kick (RoleCenterBack::doKick, the chain
-//    action; only the command's kind is modelled, since HFO ends the episode as captured about
-//    2 cycles later);
+//  - the ball kickable by itself and an opponent alike: SamplePlayer::doForceKick, the fastest
+//    one-step kick toward the goal it attacks (Body_KickOneStep);
+//  - the ball kickable (no teammate nearer to it): RoleCenterBack::doKick, the chain action. Its
+//    self-pass (SelfPassGenerator scored by SampleFieldEvaluator, and Bhv_NormalDribble's first
+//    kick) is modelled; where no self-pass beats the present state, the hold, whose kick is sent
+//    with power 0 (HFO ends the episode as captured about 2 cycles later). The pass and the
+//    short dribble (5 % of the recorded chain actions) and the dribble's queued turns and dashes
+//    in the cycles after its kick (IntentionNormalDribble) are not modelled;
 //  - otherwise Bhv_BasicMove: a tackle or foul tackle (Bhv_BasicTackle(0.8, 80), TackleGenerator's
 //    direction), or intercept (Body_Intercept2009) when its own reach is at most 3 cycles or at
 //    most its field teammates' and under the opponents' + 3, or go to its home position
@@ -30,11 +35,11 @@ namespace pamdp::hfo {
 
 // What a defender decided, with the .dcl's vocabulary for checking (BasicMove target point).
 struct DefenderDecision {
-  enum class Rule : uint8_t { kFrozen, kKick, kTackle, kIntercept, kBasicMove };
+  enum class Rule : uint8_t { kFrozen, kKick, kSelfPass, kTackle, kIntercept, kBasicMove };
   Rule rule = Rule::kBasicMove;
   agent2d::Command command;
   bool foul = false;  // a foul tackle ((tackle DIR on))
-  Vec2 target;        // kBasicMove: the home position, in the global frame
+  Vec2 target;        // kBasicMove: the home position; kSelfPass: the receive point (global frame)
 };
 
 // The defender's world model, mirrored into its own frame (goalie_world.hpp): its teammates are
