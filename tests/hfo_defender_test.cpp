@@ -9,6 +9,7 @@
 
 #include "app/env_factory.hpp"
 #include "app/experiment_config.hpp"
+#include "envs/hfo/defender.hpp"
 #include "envs/hfo/features.hpp"
 #include "envs/hfo/hfo_team_env.hpp"
 #include "envs/hfo/soccer_sim.hpp"
@@ -113,6 +114,102 @@ TEST(Defenders, StateJsonTakesThem) {
                                           "defenders": [{"x": 1, "y": 0}, {"x": 2, "y": 0}, {"x": 3, "y": 0}]})",
                                       "s.json"),
                std::runtime_error);
+}
+
+TEST(Defenders, StateJsonTakesTheirMemory) {
+  const InitialState s = parse_state_json(
+      R"({"agent": {"x": 10, "y": 0}, "ball": {"x": 30, "y": 0}, "goalie": {},
+          "defenders": [{"x": 31, "y": 0, "intention": {"kind": "dribble", "x": 22, "y": 1, "turns": 1, "dashes": 6}},
+                        {"x": 42, "y": 8, "intention": {"kind": "turn_to_forward", "x": -42, "y": 4}}]})",
+      "s.json");
+  ASSERT_EQ(s.defenders.size(), 2U);
+  const PlayerState::Intention& a = s.defenders[0].intention;
+  EXPECT_EQ(a.kind, PlayerState::Intention::Kind::kDribble);
+  EXPECT_EQ(a.target.x, 22.0);
+  EXPECT_EQ(a.turns, 1);
+  EXPECT_EQ(a.dashes, 6);
+  EXPECT_EQ(a.last_cycle, -1);  // queued the cycle before the state's cycle 0
+  EXPECT_EQ(s.defenders[1].intention.kind, PlayerState::Intention::Kind::kTurnToForward);
+  for (const char* bad : {R"({"kind": "shoot", "x": 1, "y": 0})", R"({"kind": "dribble", "x": 1, "y": 0, "turns": -1})",
+                          R"({"kind": "dribble", "y": 0})"}) {
+    try {
+      (void)parse_state_json(std::string(R"({"agent": {"x": 10, "y": 0}, "ball": {"x": 30, "y": 0}, "goalie": {},
+                                             "defenders": [{"x": 31, "y": 0, "intention": )") +
+                                 bad + "}]}",
+                             "s.json");
+      FAIL() << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("defenders[0].intention"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A game state by hand: one attacker far from play, the goalie at home, one field defender.
+SoccerState defender_game(Vec2 defender, double defender_body, Vec2 ball, Vec2 ball_vel, Vec2 attacker) {
+  SoccerState s;
+  s.num_players = 3;
+  s.players[0].pos = attacker;
+  s.players[0].team = Team::kOffense;
+  s.players[1].pos = {52.5, 0.0};
+  s.players[1].body_deg = 180.0;
+  s.players[1].team = Team::kDefense;
+  s.players[1].goalie = true;
+  s.players[2].pos = defender;
+  s.players[2].body_deg = defender_body;
+  s.players[2].team = Team::kDefense;
+  s.ball.pos = ball;
+  s.ball.vel = ball_vel;
+  s.cycle = 40;
+  return s;
+}
+
+TEST(Defenders, WithTheBallAndRoomAheadTheyDribbleOutOfTheirHalf) {
+  // Facing the half-way line (body 180 in HFO's frame), the ball at its feet, the attacker far
+  // behind it: the self-pass sends the ball toward x = 0 and queues the run after it.
+  const SoccerState s = defender_game({30.0, 5.0}, 180.0, {29.4, 5.0}, {}, {45.0, -20.0});
+  const DefenderDecision d = decide_defender(s, 2, 2, false);
+  ASSERT_EQ(d.rule, DefenderDecision::Rule::kSelfPass);
+  EXPECT_EQ(d.command.kind, agent2d::Command::Kind::kKick);
+  EXPECT_GT(d.command.p1, 10.0);
+  EXPECT_LT(d.target.x, 29.4 - 4.0);  // forward, toward the half-way line (6 dashes at most from x 29.4)
+  EXPECT_EQ(d.intention.kind, PlayerState::Intention::Kind::kDribble);
+  EXPECT_EQ(d.intention.target.x, d.target.x);
+  EXPECT_EQ(d.intention.last_cycle, s.cycle);
+  EXPECT_GE(d.intention.dashes, 5);
+}
+
+TEST(Defenders, TheQueuedDribblePlaysOnlyTheCycleAfter) {
+  // The ball rolling ahead after the kick, the queue of dashes toward its receive point.
+  SoccerState s = defender_game({30.0, 5.0}, 180.0, {28.6, 5.0}, {-0.8, 0.0}, {45.0, -20.0});
+  s.players[2].intention = {PlayerState::Intention::Kind::kDribble, {22.0, 5.0}, 0, 6, s.cycle - 1};
+  const DefenderDecision d = decide_defender(s, 2, 2, false);
+  ASSERT_EQ(d.rule, DefenderDecision::Rule::kDribbleQueue);
+  EXPECT_EQ(d.command.kind, agent2d::Command::Kind::kDash);
+  EXPECT_NEAR(d.command.p1, 100.0, 1e-9);
+  EXPECT_EQ(d.intention.dashes, 5);
+  EXPECT_EQ(d.intention.last_cycle, s.cycle);
+  // Not played the cycle before (IntentionNormalDribble::finished): the defender decides afresh.
+  s.players[2].intention.last_cycle = s.cycle - 2;
+  EXPECT_NE(decide_defender(s, 2, 2, false).rule, DefenderDecision::Rule::kDribbleQueue);
+  // An attacker at the ball breaks it off (checkOpponent).
+  s.players[2].intention.last_cycle = s.cycle - 1;
+  s.players[0].pos = {28.0, 5.6};
+  EXPECT_NE(decide_defender(s, 2, 2, false).rule, DefenderDecision::Rule::kDribbleQueue);
+}
+
+TEST(Defenders, FacingTheirOwnGoalWithTheBallTheyTurnAround) {
+  // Body 0 faces the defense's own goal; the ball at its feet stays there: turn first
+  // (Bhv_ChainAction::doTurnToForward), with no opponent within 4 m.
+  const SoccerState s = defender_game({30.0, 6.0}, 0.0, {30.5, 6.0}, {}, {45.0, -20.0});
+  const DefenderDecision d = decide_defender(s, 2, 2, false);
+  ASSERT_EQ(d.rule, DefenderDecision::Rule::kTurnForward);
+  EXPECT_EQ(d.command.kind, agent2d::Command::Kind::kTurn);
+  EXPECT_NEAR(d.target.x, -42.0, 1e-9);  // (42, y / 2) in its own frame
+  EXPECT_NEAR(d.target.y, 3.0, 1e-9);
+  // An attacker within 4 m: no turn; the chain action plays instead.
+  SoccerState near = s;
+  near.players[0].pos = {33.0, 6.0};
+  EXPECT_NE(decide_defender(near, 2, 2, false).rule, DefenderDecision::Rule::kTurnForward);
 }
 
 }  // namespace

@@ -262,9 +262,13 @@ bool self_pass_can_kick(const GoalieWorld& w, double kick_rate, Vec2 receive, do
   return true;
 }
 
-// FieldAnalyzer::predict_player_turn_cycle without back dashes.
-int turn_cycles(double body_deg, double speed, double target_dist, double target_deg, double dist_thr) {
+// FieldAnalyzer::predict_player_turn_cycle (HFO's min_dash_power -100 allows back dashes).
+int turn_cycles(double body_deg, double speed, double target_dist, double target_deg, double dist_thr,
+                bool use_back_dash = false) {
   double angle_diff = std::fabs(agent2d::angle_norm(target_deg - body_deg));
+  if (use_back_dash && target_dist < 5.0 && angle_diff > 90.0) {
+    angle_diff = std::fabs(angle_diff - 180.0);
+  }
   double turn_margin = 180.0;
   if (dist_thr < target_dist) {
     turn_margin = std::max(15.0, std::asin(dist_thr / target_dist) * kRadToDeg);
@@ -322,8 +326,8 @@ bool self_pass_safe(const GoalieWorld& w, int n_turn, int n_dash, Vec2 receive) 
 
 // SelfPassGenerator::createCourses and the one-step search over its courses: the best
 // self-pass by the field evaluation (ties to the course nearer the goal it attacks, the
-// generator's order), or false when none beats holding the ball where it is.
-bool best_self_pass(const GoalieWorld& w, double kick_rate, SelfPass* out) {
+// generator's order), or false when none scores above `floor_eval`.
+bool best_self_pass(const GoalieWorld& w, double kick_rate, double floor_eval, SelfPass* out) {
   constexpr int kAngleDivs = 60;
   constexpr double kAngleStep = 360.0 / kAngleDivs;
   constexpr int kMinDash = 5;
@@ -333,7 +337,7 @@ bool best_self_pass(const GoalieWorld& w, double kick_rate, SelfPass* out) {
   const Vec2 our_goal{-kPitchHalfLength, 0.0};
   const Vec2 their_goal{kPitchHalfLength, 0.0};
   constexpr double kTheirPenaltyLineX = kPitchHalfLength - 16.5;
-  double best_eval = field_evaluation(ball);  // the present state: ActionChainGraph's start
+  double best_eval = floor_eval;  // the present state's, ActionChainGraph's start, or a queued dribble's
   double best_goal_dist2 = DBL_MAX;
   bool found = false;
   std::array<Vec2, 24> cache{};
@@ -385,6 +389,281 @@ bool best_self_pass(const GoalieWorld& w, double kick_rate, SelfPass* out) {
   return found;
 }
 
+// IntentionNormalDribble::checkOpponent: an opponent (the nearest to the defender) at the ball
+// now, or on the ball's next position next cycle along its body, breaks the queue off.
+bool dribble_opponent_near(const GoalieWorld& w) {
+  const agent2d::PlayerView* nearest = nullptr;
+  double nearest_d2 = DBL_MAX;
+  for (int i = 0; i < w.num_opponents; ++i) {
+    const agent2d::PlayerView& o = w.opponents[static_cast<size_t>(i)];
+    if (const double d2 = (o.pos - w.self.pos).r2(); d2 < nearest_d2) {
+      nearest_d2 = d2;
+      nearest = &o;
+    }
+  }
+  if (nearest == nullptr) {
+    return false;
+  }
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  if ((nearest->pos - w.ball_pos).r() < kKickableArea + 0.2) {
+    return true;
+  }
+  if ((nearest->pos - ball_next).r() < kPlayerSpeedMax + kKickableArea + 0.3) {
+    // Full state: its body is known (bodyCount 0); the distance from the line along it.
+    const Vec2 opp_next = nearest->pos + nearest->vel;
+    const Vec2 along = polar(1.0, nearest->body_deg * kDegToRad);
+    const Vec2 rel = ball_next - opp_next;
+    if (std::fabs(along.x * rel.y - along.y * rel.x) <= 1.2 && rel.r() < 0.6 + 1.2) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// PlayerAgent::doIntention with IntentionNormalDribble: true and the command when the queue
+// plays this cycle; false when it has ended or breaks off (the defender then decides afresh).
+bool play_dribble_queue(const GoalieWorld& w, int cycle, const PlayerState::Intention& queue, double kick_rate,
+                        DefenderDecision* d) {
+  // finished()
+  if (queue.kind != PlayerState::Intention::Kind::kDribble || queue.turns + queue.dashes <= 0 ||
+      queue.last_cycle + 1 != cycle || w.exist_kickable_teammate || w.exist_kickable_opponent) {
+    return false;
+  }
+  const Vec2 target = mirror(queue.target);
+  if ((w.ball_pos - target).r2() < 1.0 && (w.self.pos - target).r2() < 1.0) {
+    return false;
+  }
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  if (std::fabs(ball_next.x) > kPitchHalfLength - 0.5 || std::fabs(ball_next.y) > kPitchHalfWidth - 0.5) {
+    return false;
+  }
+  // execute(): with the ball at its feet again and no turn left, the chain action runs again
+  // with the queued dribble among its candidates (ShortDribbleGenerator::setQueuedAction, ahead
+  // of the self-passes); anything else chosen cancels the queue.
+  if (w.self_kickable && queue.turns <= 0) {
+    const double queued = field_evaluation(target);
+    SelfPass better;
+    if (!(queued > field_evaluation(w.ball_pos)) || best_self_pass(w, kick_rate, queued, &better)) {
+      return false;
+    }
+  }
+  if (dribble_opponent_near(w)) {
+    return false;
+  }
+  PlayerState::Intention next = queue;
+  next.last_cycle = cycle;
+  if (next.turns > 0) {
+    // doTurn: toward the target from where its inertia leaves it, unless already facing it.
+    --next.turns;
+    const Vec2 my_inertia = agent2d::self_inertia_point(w, next.turns + next.dashes);
+    const double target_dist = (target - my_inertia).r();
+    const double angle_diff = agent2d::angle_norm(agent2d::th_deg(target - my_inertia) - w.self.body_deg);
+    const double margin = std::max(15.0, std::fabs(std::atan2(0.5, target_dist) * kRadToDeg));
+    if (std::fabs(angle_diff) < margin) {
+      return false;
+    }
+    d->command = agent2d::do_turn(w, angle_diff);
+  } else if (next.dashes > 0) {
+    // doDash: a safe full dash along the body, unless it would run over the ball or leave it.
+    --next.dashes;
+    const double power = agent2d::safety_dash_power(w, kMaxDashPower);
+    const Vec2 my_next =
+        w.self.pos + w.self.vel + polar(power * kDashPowerRate * w.self.effort, w.self.body_deg * kDegToRad);
+    const Vec2 rel = agent2d::rotate_deg(ball_next - my_next, -w.self.body_deg);
+    const double dist = rel.r();
+    if (dist < kPlayerSize + kBallSize || std::fabs(rel.y) > kKickableArea - 0.1) {
+      return false;
+    }
+    if (next.dashes <= 0 && dist > kKickableArea - 0.15) {
+      return false;
+    }
+    if (next.dashes > 0 &&
+        std::fabs(agent2d::angle_norm(w.self.body_deg - agent2d::th_deg(ball_next - my_next))) > 90.0 &&
+        dist > kKickableArea - 0.2) {
+      return false;
+    }
+    d->command = agent2d::do_dash(w, power, 0.0);
+  } else {
+    return false;
+  }
+  d->rule = DefenderDecision::Rule::kDribbleQueue;
+  d->target = queue.target;
+  d->intention = next;
+  return true;
+}
+
+// --- Bhv_ChainAction::doTurnToForward and its IntentionTurnTo -------------------------------
+
+// The opponents by distance from the defender (WorldModel::opponentsFromSelf), into `order`.
+int opponents_from_self(const GoalieWorld& w, std::array<int, GoalieWorld::kMaxOpponents>* order) {
+  const int n = w.num_opponents;
+  for (int i = 0; i < n; ++i) {
+    (*order)[static_cast<size_t>(i)] = i;
+  }
+  std::sort(order->begin(), order->begin() + n, [&](int a, int b) {
+    return (w.opponents[static_cast<size_t>(a)].pos - w.self.pos).r2() <
+           (w.opponents[static_cast<size_t>(b)].pos - w.self.pos).r2();
+  });
+  return n;
+}
+
+// FieldAnalyzer::predict_player_reach_cycle with keep_ball's arguments (no penalty distance, its
+// body known, no wait, back dashes allowed).
+int player_reach_cycle(const agent2d::PlayerView& o, Vec2 target, double dist_thr) {
+  const double speed = o.vel.r();
+  const Vec2 final_pos = o.pos + o.vel * (1.0 / (1.0 - kPlayerDecay));
+  const double final_dist = (final_pos - target).r();
+  const int final_reach =
+      turn_cycles(o.body_deg, speed, final_dist, agent2d::th_deg(target - final_pos), dist_thr, true) +
+      agent2d::cycles_to_reach_distance(final_dist);
+  constexpr int kMaxCycle = 6;
+  if (final_reach > kMaxCycle) {
+    return final_reach;
+  }
+  for (int cycle = 0; cycle <= kMaxCycle; ++cycle) {
+    const Vec2 inertia = o.pos + o.vel * ((1.0 - agent2d::player_decay_pow(cycle)) / (1.0 - kPlayerDecay));
+    const double target_dist = (inertia - target).r();
+    if (target_dist < dist_thr) {
+      return cycle;
+    }
+    const double dash_dist = target_dist - dist_thr * 0.5;
+    if (dash_dist < 0.001) {
+      return cycle;
+    }
+    if (dash_dist > agent2d::kRealSpeedMax * cycle) {
+      continue;
+    }
+    const int n_dash = agent2d::cycles_to_reach_distance(dash_dist);
+    if (n_dash > cycle) {
+      continue;
+    }
+    const int n_turn = turn_cycles(o.body_deg, speed, target_dist, agent2d::th_deg(target - inertia), dist_thr, true);
+    if (n_turn + n_dash <= cycle) {
+      return cycle;
+    }
+  }
+  return final_reach;
+}
+
+// Bhv_ChainAction::getKeepBallVel: of 12 points around where the defender will be in two
+// cycles, the ball velocity that takes the ball there (in two cycles) and leaves the nearby
+// opponents (within 10 m) the most steps to it, then the slowest; false when no kick reaches any.
+bool keep_ball_vel(const GoalieWorld& w, double kick_rate, Vec2* out) {
+  constexpr int kAngleDivs = 12;
+  const double collide_dist2 = std::pow(kPlayerSize + kBallSize, 2);
+  const double keep_dist = kPlayerSize + kKickableMargin * 0.5 + kBallSize;
+  const Vec2 next_self = w.self.pos + w.self.vel;
+  const Vec2 next2_self = next_self + w.self.vel * kPlayerDecay;
+  std::array<int, GoalieWorld::kMaxOpponents> order{};
+  const int n_opp = opponents_from_self(w, &order);
+  bool found = false;
+  int best_opponent_step = 0;
+  double best_speed = 1000.0;
+  for (int a = 0; a < kAngleDivs; ++a) {
+    const Vec2 keep = next2_self + polar(keep_dist, 360.0 / kAngleDivs * a * kDegToRad);
+    if (std::fabs(keep.x) > kPitchHalfLength - 0.2 || std::fabs(keep.y) > kPitchHalfWidth - 0.2) {
+      continue;
+    }
+    const Vec2 move = keep - w.ball_pos;
+    const double speed = move.r() / (1.0 + kBallDecay);
+    const double move_deg = agent2d::th_deg(move);
+    if (max_possible_vel(move_deg, kick_rate, w.ball_vel, false).r2() < speed * speed) {
+      continue;
+    }
+    const Vec2 vel = polar(speed, move_deg * kDegToRad);
+    const Vec2 ball_next = w.ball_pos + vel;
+    Vec2 ball_next_next = keep;
+    if ((next_self - ball_next).r2() < collide_dist2) {
+      ball_next_next = ball_next + vel * (kBallDecay * -0.1);
+    }
+    int min_step = 1000;
+    for (int i = 0; i < n_opp; ++i) {
+      const agent2d::PlayerView& o = w.opponents[static_cast<size_t>(order[static_cast<size_t>(i)])];
+      if ((o.pos - w.self.pos).r() > 10.0) {
+        break;
+      }
+      const int o_step = player_reach_cycle(o, ball_next_next, kKickableArea);
+      if (o_step <= 0) {
+        break;
+      }
+      min_step = std::min(min_step, o_step);
+    }
+    if (min_step > best_opponent_step || (min_step == best_opponent_step && best_speed > speed)) {
+      *out = vel;
+      best_opponent_step = min_step;
+      best_speed = speed;
+      found = true;
+    }
+  }
+  return found;
+}
+
+// Bhv_ChainAction::doTurnToForward: true and the command when the defender, facing its own goal
+// (over 110 degrees off (42, 0)) with no opponent within 4 m, turns toward (42, y / 2), or kicks
+// the ball to a keep point first when it would leave its feet (then turns the next cycle).
+bool turn_to_forward(const GoalieWorld& w, int cycle, double kick_rate, DefenderDecision* d) {
+  Vec2 face{42.0, 0.0};
+  if (std::fabs(agent2d::angle_norm(agent2d::th_deg(face - w.self.pos) - w.self.body_deg)) < 110.0) {
+    return false;
+  }
+  std::array<int, GoalieWorld::kMaxOpponents> order{};
+  const int n_opp = opponents_from_self(w, &order);
+  for (int i = 0; i < n_opp; ++i) {
+    const double dist = (w.opponents[static_cast<size_t>(order[static_cast<size_t>(i)])].pos - w.self.pos).r();
+    if (dist < 4.0) {
+      return false;
+    }
+    if (dist > 10.0) {
+      break;
+    }
+  }
+  face.y = w.self.pos.y * 0.5;
+  const double kickable = kKickableArea - w.self.vel.r() * w.player_rand - w.ball_vel.r() * w.ball_rand - 0.2;
+  const Vec2 self_next = w.self.pos + w.self.vel;
+  const Vec2 ball_next = w.ball_pos + w.ball_vel;
+  d->rule = DefenderDecision::Rule::kTurnForward;
+  d->target = mirror(face);
+  if ((self_next - ball_next).r2() < kickable * kickable) {
+    agent2d::body_turn_to_point(w, face, 1, &d->command);
+    return true;
+  }
+  Vec2 vel;
+  if (!keep_ball_vel(w, kick_rate, &vel)) {
+    return false;
+  }
+  const Vec2 accel = vel - w.ball_vel;
+  const double power = accel.r() / kick_rate;
+  // Over the maximum power agent2d holds the ball instead (Body_HoldBall, not modelled: a kick
+  // of power 0).
+  d->command = power > kMaxKickPower ? Command{Command::Kind::kKick, 0.0, 0.0}
+                                     : Command{Command::Kind::kKick, power,
+                                               agent2d::angle_norm(agent2d::th_deg(accel) - w.self.body_deg)};
+  d->intention = {PlayerState::Intention::Kind::kTurnToForward, d->target, 0, 0, cycle};
+  return true;
+}
+
+// PlayerAgent::doIntention with IntentionTurnTo: the cycle after the keep kick, the turn toward
+// the face point while the ball stays at its feet and no opponent is about to reach it.
+bool play_turn_to(const GoalieWorld& w, int cycle, const PlayerState::Intention& intention, DefenderDecision* d) {
+  if (intention.kind != PlayerState::Intention::Kind::kTurnToForward || intention.last_cycle + 1 != cycle ||
+      !w.self_kickable || w.exist_kickable_opponent) {
+    return false;
+  }
+  InterceptTable table;
+  agent2d::predict_ball_and_opponents(w, &table);
+  if (table.opponent_reach_cycle <= 1) {
+    return false;
+  }
+  const double kickable = kKickableArea - w.self.vel.r() * w.player_rand - w.ball_vel.r() * w.ball_rand - 0.15;
+  if ((w.self.pos + w.self.vel - (w.ball_pos + w.ball_vel)).r2() > kickable * kickable) {
+    return false;
+  }
+  d->rule = DefenderDecision::Rule::kTurnForward;
+  d->target = intention.target;
+  agent2d::body_turn_to_point(w, mirror(intention.target), 1, &d->command);
+  return true;
+}
+
 }  // namespace
 
 GoalieWorld defender_world(const SoccerState& s, int defender, bool server_noise) {
@@ -402,6 +681,10 @@ DefenderDecision decide_defender(const SoccerState& s, int defender, int unum, b
     d.rule = DefenderDecision::Rule::kFrozen;
     return d;
   }
+  const PlayerState::Intention& intention = s.players[static_cast<size_t>(defender)].intention;
+  if (play_dribble_queue(w, s.cycle, intention, self_kick_rate(w), &d) || play_turn_to(w, s.cycle, intention, &d)) {
+    return d;
+  }
   // SamplePlayer::doPreprocess checks the simultaneous kick before the role plays.
   if (w.self_kickable && w.exist_kickable_opponent) {
     d.rule = DefenderDecision::Rule::kKick;
@@ -415,15 +698,19 @@ DefenderDecision decide_defender(const SoccerState& s, int defender, int unum, b
   }
   if (kickable) {
     d.rule = DefenderDecision::Rule::kKick;
-    d.command = {Command::Kind::kKick, 0.0, 0.0};  // the hold: its kick is not modelled
     const double kick_rate = self_kick_rate(w);
+    if (turn_to_forward(w, s.cycle, kick_rate, &d)) {
+      return d;
+    }
+    d.command = {Command::Kind::kKick, 0.0, 0.0};  // the hold: its kick is not modelled
     SelfPass pass;
-    if (best_self_pass(w, kick_rate, &pass)) {
+    if (best_self_pass(w, kick_rate, field_evaluation(w.ball_pos), &pass)) {
       // Bhv_NormalDribble's first kick: the ball toward the receive point at the first speed.
       const Vec2 first_vel = polar(pass.first_speed, agent2d::th_deg(pass.receive - w.ball_pos) * kDegToRad);
       const Vec2 accel = first_vel - w.ball_vel;
       d.rule = DefenderDecision::Rule::kSelfPass;
       d.target = mirror(pass.receive);
+      d.intention = {PlayerState::Intention::Kind::kDribble, d.target, pass.n_turn, pass.n_dash, s.cycle};
       d.command = {Command::Kind::kKick, accel.r() / kick_rate,
                    agent2d::angle_norm(agent2d::th_deg(accel) - w.self.body_deg)};
     }

@@ -4,7 +4,8 @@
 // d222758), re-implemented from its rules on the goalie's world model and librcsc actions
 // (goalie_world.hpp; the intercept with SelfView::goalie false).
 //
-// decide_defender() is a pure function of the state at the start of a cycle; the simulator
+// decide_defender() is a pure function of the state at the start of a cycle (the defender's
+// memory included: it returns the memory after the decision); the simulator
 // plays it for env.defense_npcs >= 2, and it is checked one recorded cycle at a time against the
 // real server's defenders (tests/hfo_defender_real_data_test.cpp). What it does each cycle:
 //  - frozen by its own tackle: no body command;
@@ -14,8 +15,13 @@
 //    self-pass (SelfPassGenerator scored by SampleFieldEvaluator, and Bhv_NormalDribble's first
 //    kick) is modelled; where no self-pass beats the present state, the hold, whose kick is sent
 //    with power 0 (HFO ends the episode as captured about 2 cycles later). The pass and the
-//    short dribble (5 % of the recorded chain actions) and the dribble's queued turns and dashes
-//    in the cycles after its kick (IntentionNormalDribble) are not modelled;
+//    short dribble (5 % of the recorded chain actions) are not modelled;
+//    Before the chain action, Bhv_ChainAction::doTurnToForward: facing its own goal with no
+//    opponent within 4 m, it turns toward the other goal, or, when the ball would leave its
+//    feet, kicks it to a keep point and turns the next cycle;
+//  - before all of these (SamplePlayer::doPreprocess -> doIntention), the intention queued by
+//    an earlier cycle (PlayerState::Intention): the self-pass's turns and dashes toward its
+//    receive point (IntentionNormalDribble) or the turn after a keep kick (IntentionTurnTo);
 //  - otherwise Bhv_BasicMove: a tackle or foul tackle (Bhv_BasicTackle(0.8, 80), TackleGenerator's
 //    direction), or intercept (Body_Intercept2009) when its own reach is at most 3 cycles or at
 //    most its field teammates' and under the opponents' + 3, or go to its home position
@@ -35,11 +41,12 @@ namespace pamdp::hfo {
 
 // What a defender decided, with the .dcl's vocabulary for checking (BasicMove target point).
 struct DefenderDecision {
-  enum class Rule : uint8_t { kFrozen, kKick, kSelfPass, kTackle, kIntercept, kBasicMove };
+  enum class Rule : uint8_t { kFrozen, kKick, kSelfPass, kDribbleQueue, kTurnForward, kTackle, kIntercept, kBasicMove };
   Rule rule = Rule::kBasicMove;
   agent2d::Command command;
-  bool foul = false;  // a foul tackle ((tackle DIR on))
-  Vec2 target;        // kBasicMove: the home position; kSelfPass: the receive point (global frame)
+  bool foul = false;                 // a foul tackle ((tackle DIR on))
+  Vec2 target;                       // kBasicMove: the home position; kSelfPass: the receive point (global frame)
+  PlayerState::Intention intention;  // the defender's memory after this decision
 };
 
 // The defender's world model, mirrored into its own frame (goalie_world.hpp): its teammates are

@@ -114,6 +114,21 @@ struct PlayerState {
   // Goalie's own memory: it caught the ball this episode and heard the referee's
   // goalie_catch_ball, so it plays the set play until the reset (goalie_world.hpp, catch_mode).
   bool caught = false;
+  // A field defender's own memory: agent2d's queued intention (PlayerAgent holds one at a time).
+  // kDribble (IntentionNormalDribble): after its self-pass kick it plays queued turns, then
+  // dashes, toward the receive point, one a cycle while the queue holds. kTurnToForward
+  // (Bhv_ChainAction's IntentionTurnTo): after a kick that keeps the ball, it turns toward the
+  // face point the next cycle. `target` is in the global frame; last_cycle is the state's cycle
+  // when the defender last played from (or set) the intention.
+  struct Intention {
+    enum class Kind : uint8_t { kNone, kDribble, kTurnToForward };
+    Kind kind = Kind::kNone;
+    Vec2 target;
+    int turns = 0;
+    int dashes = 0;
+    int last_cycle = -1;
+  };
+  Intention intention;
   bool collided_ball = false;
   bool collided_player = false;
   bool collided_post = false;

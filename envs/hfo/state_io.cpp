@@ -123,6 +123,36 @@ ScriptedAction parse_action(const std::string& text, const std::string& where) {
   return a;
 }
 
+// A field defender's memory: {"kind": "dribble" | "turn_to_forward", "x", "y", "turns", "dashes"},
+// queued the cycle before the state's (PlayerState::Intention).
+PlayerState::Intention parse_intention(const nlohmann::json& j, const std::string& group, const std::string& src) {
+  const char* g = group.c_str();
+  if (!j.is_object()) {
+    throw std::runtime_error(src + ": \"" + group + "\" must be an object");
+  }
+  reject_unknown(j, g, {"kind", "x", "y", "turns", "dashes"}, src);
+  PlayerState::Intention in;
+  const std::string kind = j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : "";
+  if (kind == "dribble") {
+    in.kind = PlayerState::Intention::Kind::kDribble;
+  } else if (kind == "turn_to_forward") {
+    in.kind = PlayerState::Intention::Kind::kTurnToForward;
+  } else {
+    throw std::runtime_error(src + ": " + group + ".kind must be \"dribble\" (the self-pass's queued turns and " +
+                             "dashes) or \"turn_to_forward\" (the turn after a keep kick)");
+  }
+  in.target = {number(j, g, "x", src, {}), number(j, g, "y", src, {})};
+  for (const char* key : {"turns", "dashes"}) {
+    const double v = number(j, g, key, src, 0.0);
+    if (v < 0.0 || v > 30.0 || v != std::floor(v)) {
+      throw std::runtime_error(src + ": " + group + "." + key + " must be a whole number within [0, 30]");
+    }
+    (std::string(key) == "turns" ? in.turns : in.dashes) = static_cast<int>(v);
+  }
+  in.last_cycle = -1;  // queued the cycle before the state's first, cycle 0
+  return in;
+}
+
 }  // namespace
 
 InitialState parse_state_json(const std::string& text, const std::string& src) {
@@ -203,7 +233,7 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       if (!ds[i].is_object()) {
         throw std::runtime_error(src + ": \"" + group + "\" must be an object");
       }
-      reject_unknown(ds[i], g, {"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles"}, src);
+      reject_unknown(ds[i], g, {"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles", "intention"}, src);
       PlayerState d;
       d.pos = {number(ds[i], g, "x", src, {}), number(ds[i], g, "y", src, {})};
       d.vel = {number(ds[i], g, "vx", src, 0.0), number(ds[i], g, "vy", src, 0.0)};
@@ -218,6 +248,9 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
                                  std::to_string(kTackleCycles) + "]");
       }
       d.tackle_cycles = static_cast<int>(frozen);
+      if (ds[i].contains("intention")) {
+        d.intention = parse_intention(ds[i]["intention"], group + ".intention", src);
+      }
       s.defenders.push_back(d);
     }
   }
