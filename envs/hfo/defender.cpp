@@ -355,35 +355,58 @@ bool best_self_pass(const GoalieWorld& w, double kick_rate, double floor_eval, S
       continue;
     }
     const int size = self_pass_cache(w, dash_deg, n_turn, max_dash, &cache);
-    int n_dash = size - n_turn;
-    int count = 0;
-    int dash_dec = 2;
-    for (; n_dash >= kMinDash; n_dash -= dash_dec) {
+    // This direction's courses, the longest first (every second dash step down to 10, then each).
+    std::array<int, 12> dashes{};
+    int num = 0;
+    for (int n_dash = size - n_turn, dash_dec = 2; n_dash >= kMinDash; n_dash -= dash_dec) {
       if (n_dash <= 10) {
         dash_dec = 1;
       }
-      const Vec2 receive = cache[static_cast<size_t>(n_turn + n_dash - 1)];
-      if ((receive - our_goal).r2() < 18.0 * 18.0) {
-        continue;
-      }
-      const int steps = 1 + n_turn + n_dash;
-      const double first_speed = agent2d::first_term_geom_series((receive - ball).r(), kBallDecay, steps);
-      const bool ck = self_pass_can_kick(w, kick_rate, receive, first_speed);
-      const bool sf = ck && self_pass_safe(w, n_turn, n_dash, receive);
-      if (!sf) {
-        continue;
-      }
+      dashes[static_cast<size_t>(num++)] = n_dash;
+    }
+    // The generator keeps at most 10 courses of a direction. Only a course that could beat the
+    // best so far is checked (the checks are the cost); the others are checked only if the count
+    // they might fill decides whether an 11th course is looked at.
+    const auto receive_of = [&](int c) {
+      return cache[static_cast<size_t>(n_turn + dashes[static_cast<size_t>(c)] - 1)];
+    };
+    const auto first_speed_of = [&](int c) {
+      return agent2d::first_term_geom_series((receive_of(c) - ball).r(), kBallDecay,
+                                             1 + n_turn + dashes[static_cast<size_t>(c)]);
+    };
+    const auto accepted = [&](int c) {
+      const Vec2 receive = receive_of(c);
+      return (receive - our_goal).r2() >= 18.0 * 18.0 && self_pass_can_kick(w, kick_rate, receive, first_speed_of(c)) &&
+             self_pass_safe(w, n_turn, dashes[static_cast<size_t>(c)], receive);
+    };
+    int count = 0;
+    std::array<int, 12> unchecked{};
+    int num_unchecked = 0;
+    for (int c = 0; c < num; ++c) {
+      const Vec2 receive = receive_of(c);
       const double eval = field_evaluation(receive);
       const double goal_dist2 = (receive - their_goal).r2();
-      if (eval > best_eval || (found && eval == best_eval && goal_dist2 < best_goal_dist2)) {
-        best_eval = eval;
-        best_goal_dist2 = goal_dist2;
-        *out = {receive, first_speed, n_turn, n_dash};
-        found = true;
+      if (!(eval > best_eval || (found && eval == best_eval && goal_dist2 < best_goal_dist2))) {
+        unchecked[static_cast<size_t>(num_unchecked++)] = c;
+        continue;
       }
-      if (++count >= 10) {
-        break;
+      if (c >= 10) {  // the courses before it all kept?
+        int kept = count;
+        for (int u = 0; u < num_unchecked; ++u) {
+          kept += accepted(unchecked[static_cast<size_t>(u)]) ? 1 : 0;
+        }
+        if (kept >= 10) {
+          break;
+        }
       }
+      if (!accepted(c)) {
+        continue;
+      }
+      ++count;
+      best_eval = eval;
+      best_goal_dist2 = goal_dist2;
+      *out = {receive, first_speed_of(c), n_turn, dashes[static_cast<size_t>(c)]};
+      found = true;
     }
   }
   return found;
