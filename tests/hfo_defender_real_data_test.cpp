@@ -289,15 +289,35 @@ Stepped step_game(const std::string& file, int agents, int field_defenders, bool
   const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   Stepped out;
   int shown = 0;
+  // Each defender's memory (its queued intention) carries over from the step before, within an
+  // episode's consecutive cycles.
+  std::array<PlayerState::Intention, 2> memory{};
+  std::string memory_episode;
+  int memory_t = -10;
   for (size_t i = 0; i + 1 < rows.size(); ++i) {
     const CsvRow& r = rows[i];
     const CsvRow& n = rows[i + 1];
     if (r.str("status") != "IN_GAME" || n.str("src") != r.str("src") || n.str("ep") != r.str("ep") || r.num("t") < 2) {
       continue;  // the reset cycles and the last row of an episode
     }
+    const std::string episode = r.str("src") + "/" + r.str("ep");
+    const int cycle = static_cast<int>(r.num("t"));
+    if (episode != memory_episode || cycle != memory_t + 1) {
+      memory.fill({});
+    }
+    memory_episode = episode;
+    memory_t = cycle;
     SoccerSim sim = game_at(r, agents, field_defenders);
+    sim.mutable_state().cycle = cycle;
+    for (int k = 0; k < field_defenders; ++k) {
+      sim.mutable_state().players[static_cast<size_t>(sim.defender_index(k))].intention =
+          memory[static_cast<size_t>(k)];
+    }
     send_attackers(sim, r, &n, agents);
     sim.step();
+    for (int k = 0; k < field_defenders; ++k) {
+      memory[static_cast<size_t>(k)] = sim.state().players[static_cast<size_t>(sim.defender_index(k))].intention;
+    }
     ++out.rows;
     const SoccerState& s = sim.state();
     const auto same = [&](const PlayerState& p, const std::string& col) {
