@@ -215,7 +215,7 @@ void register_sim(CLI::App& app) {
           "teammates (optional: the other offense players, 1-3): [{x, y, vx, vy, body_deg, stamina}, ...], "
           "goalie (optional, with --goalie): {x, y, vx, vy, body_deg, stamina, since_catch, tackle_cycles, caught}, "
           "defenders (optional, with --goalie: agent2d's field defenders, 1-2): [{x, y, vx, vy, body_deg, stamina, "
-          "tackle_cycles, intention: {kind: dribble|turn_to_forward, x, y, turns, dashes}}, ...]}")
+          "tackle_cycles, recover_mode, intention: {kind: dribble|turn_to_forward, x, y, turns, dashes}}, ...]}")
       ->required()
       ->check(existing_file("give a STATE.json (an example: tests/golden/kick_to_goal.state.json)"));
   trace

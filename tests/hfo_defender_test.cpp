@@ -3,6 +3,7 @@
 // that runs to its end. Their decisions against the real server's: hfo_defender_real_data_test.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -120,7 +121,8 @@ TEST(Defenders, StateJsonTakesTheirMemory) {
   const InitialState s = parse_state_json(
       R"({"agent": {"x": 10, "y": 0}, "ball": {"x": 30, "y": 0}, "goalie": {},
           "defenders": [{"x": 31, "y": 0, "intention": {"kind": "dribble", "x": 22, "y": 1, "turns": 1, "dashes": 6}},
-                        {"x": 42, "y": 8, "intention": {"kind": "turn_to_forward", "x": -42, "y": 4}}]})",
+                        {"x": 42, "y": 8, "recover_mode": true,
+                         "intention": {"kind": "turn_to_forward", "x": -42, "y": 4}}]})",
       "s.json");
   ASSERT_EQ(s.defenders.size(), 2U);
   const PlayerState::Intention& a = s.defenders[0].intention;
@@ -130,6 +132,8 @@ TEST(Defenders, StateJsonTakesTheirMemory) {
   EXPECT_EQ(a.dashes, 6);
   EXPECT_EQ(a.last_cycle, -1);  // queued the cycle before the state's cycle 0
   EXPECT_EQ(s.defenders[1].intention.kind, PlayerState::Intention::Kind::kTurnToForward);
+  EXPECT_FALSE(s.defenders[0].recover_mode);
+  EXPECT_TRUE(s.defenders[1].recover_mode);
   for (const char* bad : {R"({"kind": "shoot", "x": 1, "y": 0})", R"({"kind": "dribble", "x": 1, "y": 0, "turns": -1})",
                           R"({"kind": "dribble", "y": 0})"}) {
     try {
@@ -210,6 +214,32 @@ TEST(Defenders, FacingTheirOwnGoalWithTheBallTheyTurnAround) {
   SoccerState near = s;
   near.players[0].pos = {33.0, 6.0};
   EXPECT_NE(decide_defender(near, 2, 2, false).rule, DefenderDecision::Rule::kTurnForward);
+}
+
+TEST(Defenders, TheRecoverModeHoldsBetweenHalfAndSevenTenthsOfTheirStamina) {
+  // An attacker with the ball 15 m out; the defender moves to its home position
+  // (Strategy::get_normal_dash_power): 76.5 normally, its recovery less 25 while recovering.
+  SoccerState s = defender_game({30.0, 12.0}, 180.0, {20.5, 0.0}, {}, {20.0, 0.0});
+  s.players[2].stamina = 5000.0;  // between half and 0.7 of 8000: the mode stays as it was
+  // Facing its home position, so that it dashes.
+  const Vec2 home = decide_defender(s, 2, 2, false).target;
+  s.players[2].body_deg = std::atan2(home.y - 12.0, home.x - 30.0) * kRadToDeg;
+  const DefenderDecision normal = decide_defender(s, 2, 2, false);
+  s.players[2].recover_mode = true;
+  const DefenderDecision recovering = decide_defender(s, 2, 2, false);
+  ASSERT_EQ(normal.rule, DefenderDecision::Rule::kBasicMove);
+  ASSERT_EQ(recovering.rule, DefenderDecision::Rule::kBasicMove);
+  EXPECT_FALSE(normal.recover_mode);
+  EXPECT_TRUE(recovering.recover_mode);
+  ASSERT_EQ(normal.command.kind, agent2d::Command::Kind::kDash);
+  EXPECT_NEAR(normal.command.p1, 76.5, 1e-9);
+  EXPECT_NEAR(recovering.command.p1, 45.0 - 25.0, 1e-9);
+  s.players[2].recover_mode = false;
+  s.players[2].stamina = 3900.0;  // under half: on
+  EXPECT_TRUE(decide_defender(s, 2, 2, false).recover_mode);
+  s.players[2].recover_mode = true;
+  s.players[2].stamina = 5700.0;  // over 0.7 of 8000 (5,600): off
+  EXPECT_FALSE(decide_defender(s, 2, 2, false).recover_mode);
 }
 
 }  // namespace

@@ -60,9 +60,18 @@ bool basic_tackle(const GoalieWorld& w, const InterceptTable& t, DefenderDecisio
   return true;
 }
 
-// Strategy::get_normal_dash_power without its memory (the recover mode, kept while stamina is
-// between half and 0.7 of the maximum; the smoothed defense line).
-double normal_dash_power(const GoalieWorld& w, const InterceptTable& t) {
+// Strategy::get_normal_dash_power, with its memory: the recover mode, on below half the maximum
+// stamina and off above 0.7 of it (static thread_local in agent2d: each defender its own).
+double normal_dash_power(const GoalieWorld& w, const InterceptTable& t, bool* recover_mode) {
+  const agent2d::StaminaModel stamina = agent2d::stamina_of(w.self);
+  if (stamina.capacity_is_empty()) {
+    return std::min(kMaxDashPower, w.self.stamina + kExtraStamina);
+  }
+  if (w.self.stamina < kStaminaMax * 0.5) {
+    *recover_mode = true;
+  } else if (w.self.stamina > kStaminaMax * 0.7) {
+    *recover_mode = false;
+  }
   const double my_inc = kStaminaIncMax * w.self.recovery;
   // WorldModel::ourDefenseLineX: the second-deepest of its side (itself included), 0 at most,
   // and the ball's x when the ball is deeper.
@@ -84,7 +93,7 @@ double normal_dash_power(const GoalieWorld& w, const InterceptTable& t) {
   if (defense_line > w.self.pos.x && w.ball_pos.x < defense_line + 20.0) {
     return kMaxDashPower;
   }
-  if (w.self.stamina < kStaminaMax * 0.5) {
+  if (*recover_mode) {
     return std::max(0.0, my_inc - 25.0);
   }
   if (w.exist_kickable_teammate && w.ball_dist_from_self < 20.0) {
@@ -700,6 +709,7 @@ GoalieWorld defender_world(const SoccerState& s, int defender, bool server_noise
 DefenderDecision decide_defender(const SoccerState& s, int defender, int unum, bool server_noise) {
   const GoalieWorld w = defender_world(s, defender, server_noise);
   DefenderDecision d;
+  d.recover_mode = s.players[static_cast<size_t>(defender)].recover_mode;
   if (w.self.frozen) {
     d.rule = DefenderDecision::Rule::kFrozen;
     return d;
@@ -770,7 +780,7 @@ DefenderDecision decide_defender(const SoccerState& s, int defender, int unum, b
   const Vec2 target = agent2d::formation_position(agent2d::formation_data(kind), unum, focus);
   d.rule = DefenderDecision::Rule::kBasicMove;
   d.target = mirror(target);
-  const double dash_power = normal_dash_power(w, table);
+  const double dash_power = normal_dash_power(w, table, &d.recover_mode);
   const double dist_thr = std::max(1.0, w.ball_dist_from_self * 0.1);
   if (!agent2d::body_go_to_point(w, target, dist_thr, dash_power, -1.0, 100, true, 15.0, &d.command)) {
     agent2d::body_turn_to_point(w, agent2d::ball_inertia_point(w, 1), 1, &d.command);

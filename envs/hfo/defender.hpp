@@ -46,7 +46,8 @@ struct DefenderDecision {
   agent2d::Command command;
   bool foul = false;                 // a foul tackle ((tackle DIR on))
   Vec2 target;                       // kBasicMove: the home position; kSelfPass: the receive point (global frame)
-  PlayerState::Intention intention;  // the defender's memory after this decision
+  PlayerState::Intention intention;  // the defender's memory after this decision:
+  bool recover_mode = false;         // and Strategy's recover mode
 };
 
 // The defender's world model, mirrored into its own frame (goalie_world.hpp): its teammates are

@@ -64,19 +64,17 @@ void GoalieWorld::finish() {
   // SelfObject::updateBallInfo: kickable within the type's kickable area less a buffer of
   // 0.055 for a ball seen this cycle (full state).
   self_kickable = ball_dist_from_self <= kKickableArea - 0.055;
-  // WorldModel::updatePlayerStateCache / check_player_kickable: only the opponent nearest to
-  // the ball counts; it is kickable within kickable_area + an error that grows with the
-  // distances from the goalie (ball: 2 %, player: 2 %, each at most 0.25).
-  const auto kickable = [&](const PlayerView& p) {
-    if (p.tackling) {
-      return false;
-    }
-    const double ball_error = std::min(0.25, ball_dist_from_self * 0.02);
-    const double player_error = std::min(0.25, (p.pos - self.pos).r() * 0.02);
-    return (p.pos - ball_pos).r() < kKickableArea + ball_error + player_error;
+  // WorldModel::updatePlayerStateCache / check_player_kickable: only the player nearest to the
+  // ball counts. An opponent is kickable within kickable_area + an error that grows with the
+  // distances from self (ball: 2 %, player: 2 %, each at most 0.25); a teammate within
+  // kickable_area itself (no error).
+  const auto kickable = [&](const PlayerView& p, double error) {
+    return !p.tackling && (p.pos - ball_pos).r() < kKickableArea + error;
   };
-  exist_kickable_opponent = num_opponents > 0 && kickable(opponents[0]);
-  exist_kickable_teammate = num_teammates > 0 && kickable(teammates[0]);
+  exist_kickable_opponent =
+      num_opponents > 0 && kickable(opponents[0], std::min(0.25, ball_dist_from_self * 0.02) +
+                                                      std::min(0.25, (opponents[0].pos - self.pos).r() * 0.02));
+  exist_kickable_teammate = num_teammates > 0 && kickable(teammates[0], 0.0);
 }
 
 Command do_dash(const GoalieWorld& w, double power, double dir_deg) {

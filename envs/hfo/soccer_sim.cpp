@@ -550,6 +550,7 @@ void SoccerSim::sense_goalie() {
   for (int k = 0; k < config_.field_defenders; ++k) {
     const DefenderDecision d = decide_defender(state_, defender_index(k), k + 2, config_.noise);
     state_.players[defender_index(k)].intention = d.intention;  // its own memory, read only by itself
+    state_.players[defender_index(k)].recover_mode = d.recover_mode;
     pending_defender_command_[static_cast<size_t>(k)] = {static_cast<uint8_t>(d.command.kind), d.command.p1,
                                                          d.command.p2, d.foul};
   }

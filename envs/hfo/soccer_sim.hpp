@@ -129,6 +129,10 @@ struct PlayerState {
     int last_cycle = -1;
   };
   Intention intention;
+  // A field defender's Strategy::get_normal_dash_power memory: the recover mode (on below half
+  // the maximum stamina, off above 0.7 of it), in which it dashes to its home position at the
+  // power it recovers less 25.
+  bool recover_mode = false;
   bool collided_ball = false;
   bool collided_player = false;
   bool collided_post = false;
