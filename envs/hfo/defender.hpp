@@ -2,7 +2,8 @@
 // the role of unums 2 and 3 that HFO runs for --defense-npcs 2 and 3 (HFO b8b2a1d
 // src/role_center_back.cpp, bhv_basic_move.cpp, bhv_basic_tackle.cpp, strategy.cpp on librcsc
 // d222758), re-implemented from its rules on the goalie's world model and librcsc actions
-// (goalie_world.hpp; the intercept with SelfView::goalie false).
+// (goalie_world.hpp; the intercept with SelfView::goalie false). What it does with the ball is in
+// defender_ball.hpp.
 //
 // decide_defender() is a pure function of the state at the start of a cycle (the defender's
 // memory included: it returns the memory after the decision); the simulator
