@@ -1,4 +1,4 @@
-// HFO's field defenders in the embedded simulator (issue 83, in progress): agent2d's CenterBack,
+// HFO's field defenders in the embedded simulator (issue 83): agent2d's CenterBack,
 // the role of unums 2 and 3 that HFO runs for --defense-npcs 2 and 3 (HFO b8b2a1d
 // src/role_center_back.cpp, bhv_basic_move.cpp, bhv_basic_tackle.cpp, strategy.cpp on librcsc
 // d222758), re-implemented from its rules on the goalie's world model and librcsc actions
@@ -30,9 +30,11 @@
 //    the ball when there.
 // Its world model is the truth (both teams get full state), with librcsc's one correction: the
 // ball's velocity is believed 0 while an opponent can kick it and the defender cannot
-// (WorldModel::updateJustBeforeDecision -> BallObject::setOpponentControlEffect). Memory agent2d
-// keeps across cycles (Strategy's recover mode, WorldModel's smoothed defense line) and what the
-// defenders tell each other are not modelled yet.
+// (WorldModel::updateJustBeforeDecision -> BallObject::setOpponentControlEffect). Its memory
+// lives in PlayerState: the queued intention and Strategy's recover mode. Not modelled: the
+// smoothing WorldModel::updateOurDefenseLine applies to a defense line moving up by 5-13 m in a
+// cycle, and the chain action's pass and short dribble. What the defenders tell each other
+// changes none of these decisions with full state (docs/simulator.md).
 #pragma once
 
 #include "envs/hfo/goalie_world.hpp"
