@@ -13,10 +13,7 @@ namespace {
 using agent2d::Command;
 using agent2d::GoalieWorld;
 using agent2d::InterceptTable;
-
-Vec2 mirror(Vec2 v) {
-  return {-v.x, -v.y};
-}
+using agent2d::mirror;
 
 // Line through p along `deg`, met with the goal line: Ray2D::intersection in Bhv_BasicTackle.
 bool ball_into_our_goal(const GoalieWorld& w, Vec2 self_reach_point) {

@@ -15,10 +15,7 @@ namespace {
 using agent2d::Command;
 using agent2d::GoalieWorld;
 using agent2d::InterceptTable;
-
-Vec2 mirror(Vec2 v) {
-  return {-v.x, -v.y};
-}
+using agent2d::mirror;
 
 // Body_KickOneStep::get_max_possible_vel: the fastest first velocity along `angle_deg` one kick
 // can give a ball moving at `ball_vel` (relative to the ball), or the kick that stops the ball
@@ -166,26 +163,6 @@ bool self_pass_can_kick(const GoalieWorld& w, double kick_rate, Vec2 receive, do
   return true;
 }
 
-// FieldAnalyzer::predict_player_turn_cycle (HFO's min_dash_power -100 allows back dashes).
-int turn_cycles(double body_deg, double speed, double target_dist, double target_deg, double dist_thr,
-                bool use_back_dash = false) {
-  double angle_diff = std::fabs(agent2d::angle_norm(target_deg - body_deg));
-  if (use_back_dash && target_dist < 5.0 && angle_diff > 90.0) {
-    angle_diff = std::fabs(angle_diff - 180.0);
-  }
-  double turn_margin = 180.0;
-  if (dist_thr < target_dist) {
-    turn_margin = std::max(15.0, std::asin(dist_thr / target_dist) * kRadToDeg);
-  }
-  int n_turn = 0;
-  while (angle_diff > turn_margin) {
-    angle_diff -= kMaxMoment / (1.0 + kInertiaMoment * speed);
-    speed *= kPlayerDecay;
-    ++n_turn;
-  }
-  return n_turn;
-}
-
 // SelfPassGenerator::checkOpponent: no opponent reaches the receive point first (with full
 // state every position and velocity count is 0, which fixes the bonus steps).
 bool self_pass_safe(const GoalieWorld& w, int n_turn, int n_dash, Vec2 receive) {
@@ -207,8 +184,8 @@ bool self_pass_safe(const GoalieWorld& w, int n_turn, int n_dash, Vec2 receive) 
     }
     const double dash_dist = target_dist - kKickableArea - 0.2 - (o.pos - w.self.pos).r() * 0.01;
     const int opp_n_dash = agent2d::cycles_to_reach_distance(dash_dist);
-    const int opp_n_turn =
-        turn_cycles(o.body_deg, o.vel.r(), target_dist, agent2d::th_deg(receive - opp_pos), kKickableArea);
+    const int opp_n_turn = agent2d::predict_player_turn_cycle(o.body_deg, o.vel.r(), target_dist,
+                                                              agent2d::th_deg(receive - opp_pos), kKickableArea, false);
     const int opp_n_step = opp_n_turn == 0 ? opp_n_dash : opp_n_turn + opp_n_dash + 1;
     int bonus_step = receive.x < 27.0 ? 1 : 0;
     if (o.tackling) {
@@ -443,9 +420,9 @@ int player_reach_cycle(const agent2d::PlayerView& o, Vec2 target, double dist_th
   const double speed = o.vel.r();
   const Vec2 final_pos = o.pos + o.vel * (1.0 / (1.0 - kPlayerDecay));
   const double final_dist = (final_pos - target).r();
-  const int final_reach =
-      turn_cycles(o.body_deg, speed, final_dist, agent2d::th_deg(target - final_pos), dist_thr, true) +
-      agent2d::cycles_to_reach_distance(final_dist);
+  const int final_reach = agent2d::predict_player_turn_cycle(o.body_deg, speed, final_dist,
+                                                             agent2d::th_deg(target - final_pos), dist_thr, true) +
+                          agent2d::cycles_to_reach_distance(final_dist);
   constexpr int kMaxCycle = 6;
   if (final_reach > kMaxCycle) {
     return final_reach;
@@ -467,7 +444,8 @@ int player_reach_cycle(const agent2d::PlayerView& o, Vec2 target, double dist_th
     if (n_dash > cycle) {
       continue;
     }
-    const int n_turn = turn_cycles(o.body_deg, speed, target_dist, agent2d::th_deg(target - inertia), dist_thr, true);
+    const int n_turn = agent2d::predict_player_turn_cycle(o.body_deg, speed, target_dist,
+                                                          agent2d::th_deg(target - inertia), dist_thr, true);
     if (n_turn + n_dash <= cycle) {
       return cycle;
     }

@@ -384,25 +384,6 @@ int ball_move_step(double speed, double dist) {
   return static_cast<int>(std::ceil(n) + 1.0e-10);
 }
 
-// FieldAnalyzer::predict_player_turn_cycle (back dashes allowed).
-int player_turn_cycles(double body_deg, double speed, double target_dist, double target_deg, double dist_thr) {
-  double angle_diff = std::fabs(angle_norm(target_deg - body_deg));
-  if (target_dist < 5.0 && angle_diff > 90.0 && kMinDashPower < -kMaxDashPower + 1.0) {
-    angle_diff = std::fabs(angle_diff - 180.0);
-  }
-  double turn_margin = 180.0;
-  if (dist_thr < target_dist) {
-    turn_margin = std::max(15.0, std::asin(dist_thr / target_dist) * kRadToDeg);
-  }
-  int n_turn = 0;
-  while (angle_diff > turn_margin) {
-    angle_diff -= kMaxMoment / (1.0 + kInertiaMoment * speed);
-    speed *= kPlayerDecay;
-    ++n_turn;
-  }
-  return n_turn;
-}
-
 // TackleGenerator::predictOpponentReachStep, with full state (no position or body count).
 int opponent_reach_step(const agent2d::PlayerView& o, Vec2 ball_pos, Vec2 ball_vel, double move_deg, int max_cycle) {
   const double speed = o.vel.r();
@@ -436,7 +417,8 @@ int opponent_reach_step(const agent2d::PlayerView& o, Vec2 ball_pos, Vec2 ball_v
     if (n_dash > cycle) {
       continue;
     }
-    const int n_turn = player_turn_cycles(o.body_deg, speed, target_dist, th_deg(ball - inertia), kKickableArea);
+    const int n_turn =
+        agent2d::predict_player_turn_cycle(o.body_deg, speed, target_dist, th_deg(ball - inertia), kKickableArea, true);
     int n_step = n_turn == 0 ? n_dash : n_turn + n_dash + 1;
     if (o.tackling) {
       n_step += 5;
@@ -728,8 +710,7 @@ double tackle_generator_angle(const agent2d::GoalieWorld& w) {
 }
 
 agent2d::GoalieWorld defense_world(const SoccerState& s, int self, bool server_noise) {
-  // rcssserver sends the right side every position mirrored through the centre.
-  auto mirror = [](Vec2 v) { return Vec2{-v.x, -v.y}; };
+  using agent2d::mirror;
   auto view = [&](const PlayerState& p) {
     agent2d::PlayerView v;
     v.pos = mirror(p.pos);

@@ -46,6 +46,25 @@ int cycles_to_reach_distance(double dash_dist) {
   return static_cast<int>(t.size()) + static_cast<int>(std::ceil(rest / kRealSpeedMax));
 }
 
+int predict_player_turn_cycle(double body_deg, double speed, double target_dist, double target_deg, double dist_thr,
+                              bool use_back_dash) {
+  double angle_diff = std::fabs(angle_norm(target_deg - body_deg));
+  if (use_back_dash && target_dist < 5.0 && angle_diff > 90.0 && kMinDashPower < -kMaxDashPower + 1.0) {
+    angle_diff = std::fabs(angle_diff - 180.0);  // a backward dash
+  }
+  double turn_margin = 180.0;
+  if (dist_thr < target_dist) {
+    turn_margin = std::max(15.0, std::asin(dist_thr / target_dist) * kRadToDeg);
+  }
+  int n_turn = 0;
+  while (angle_diff > turn_margin) {
+    angle_diff -= kMaxMoment / (1.0 + kInertiaMoment * speed);
+    speed *= kPlayerDecay;
+    ++n_turn;
+  }
+  return n_turn;
+}
+
 namespace {
 
 Vec2 inertia_point(Vec2 pos, Vec2 vel, int n) {

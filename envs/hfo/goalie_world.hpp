@@ -48,6 +48,11 @@ inline Vec2 rotate_deg(Vec2 v, double deg) {
 inline double first_term_geom_series(double sum, double r, int len) {
   return sum * (1.0 - r) / (1.0 - std::pow(r, len));
 }
+// rcssserver sends the right side (HFO's defense) every position mirrored through the centre:
+// the global frame to a defense player's own, and back.
+inline Vec2 mirror(Vec2 v) {
+  return {-v.x, -v.y};
+}
 
 // PlayerType::realSpeedMax() of type 0: min(100 x 0.006 x 1 / (1 - 0.4), 1.05) = 1.0.
 inline constexpr double kRealSpeedMax = kMaxDashPower * kDashPowerRate / (1.0 - kPlayerDecay) < kPlayerSpeedMax
@@ -217,6 +222,11 @@ void predict_ball_and_opponents(const GoalieWorld& world, InterceptTable* table)
 void predict_self(const GoalieWorld& world, InterceptTable* table);
 // PlayerType::cyclesToReachDistance for player type 0 (full dashes from rest).
 int cycles_to_reach_distance(double dash_dist);
+// FieldAnalyzer::predict_player_turn_cycle for player type 0: the turns a player moving at
+// `speed` needs to face a target `target_dist` away at `target_deg` within `dist_thr`; with
+// `use_back_dash`, a target within 5 m behind it counts as ahead (HFO's min_dash_power is -100).
+int predict_player_turn_cycle(double body_deg, double speed, double target_dist, double target_deg, double dist_thr,
+                              bool use_back_dash);
 inline void predict_intercepts(const GoalieWorld& world, InterceptTable* table) {
   predict_ball_and_opponents(world, table);
   predict_self(world, table);

@@ -233,8 +233,8 @@ InitialState parse_state_json(const std::string& text, const std::string& src) {
       if (!ds[i].is_object()) {
         throw std::runtime_error(src + ": \"" + group + "\" must be an object");
       }
-      reject_unknown(ds[i], g, {"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles", "intention", "recover_mode"},
-                     src);
+      reject_unknown(ds[i], g,
+                     {"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles", "intention", "recover_mode"}, src);
       PlayerState d;
       d.pos = {number(ds[i], g, "x", src, {}), number(ds[i], g, "y", src, {})};
       d.vel = {number(ds[i], g, "vx", src, 0.0), number(ds[i], g, "vy", src, 0.0)};

@@ -12,12 +12,13 @@
 // catch command, tackle_cycles the cycles its own tackle still freezes it (0-10), and caught says
 // it caught the ball earlier in the episode (it then only keeps its position until the reset).
 // "defenders" is optional (with "goalie" or --goalie): agent2d's field defenders, unums 2 and 3,
-// [{"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles", "recover_mode", "intention"}, ...], at most 2; each key
-// missing takes 0 (velocities, tackle_cycles), 180 (body_deg) or 8000 (stamina); x and y are
-// required. "intention" (optional) is the defender's memory, queued the cycle before:
+// at most 2: [{"x", "y", "vx", "vy", "body_deg", "stamina", "tackle_cycles", "recover_mode",
+// "intention"}, ...]. Each key missing takes 0 (velocities, tackle_cycles), 180 (body_deg), 8000
+// (stamina) or false (recover_mode, Strategy's recover mode); x and y are required. "intention"
+// (optional; none by default) is the defender's memory, queued the cycle before:
 // {"kind": "dribble", "x", "y", "turns", "dashes"} (its self-pass's turns and dashes left toward
 // the receive point x, y) or {"kind": "turn_to_forward", "x", "y"} (the turn toward x, y after a
-// keep kick); none by default. "recover_mode" (optional, false) is its Strategy's recover mode.
+// keep kick).
 // ACTIONS.csv: one action per row: DASH,power,dir | TURN,dir | TACKLE,dir | KICK,power,dir;
 // blank lines and lines starting with '#' are skipped. With several offense players a row holds
 // one action per player, in player order, separated by '|': DASH,80,0|KICK,60,-20.
