@@ -159,31 +159,51 @@ struct Tally {
   int chain_kicks_same_rule = 0;
 };
 
+// Each field defender's memory (its queued intention, Strategy's recover mode), carried from its
+// own decision on the row before within an episode's consecutive cycles.
+class DefenderMemory {
+ public:
+  // Forgets everything at a new episode or a gap in the cycles; returns the row's cycle.
+  int at(const CsvRow& r) {
+    const std::string episode = r.str("src") + "/" + r.str("ep");
+    const int cycle = static_cast<int>(r.num("t"));
+    if (episode != episode_ || cycle != cycle_ + 1) {
+      kept_.fill({});
+    }
+    episode_ = episode;
+    cycle_ = cycle;
+    return cycle;
+  }
+  void give(int k, PlayerState* d) const {
+    d->intention = kept_[static_cast<size_t>(k)].intention;
+    d->recover_mode = kept_[static_cast<size_t>(k)].recover_mode;
+  }
+  void keep(int k, const PlayerState::Intention& intention, bool recover_mode) {
+    kept_[static_cast<size_t>(k)] = {intention, recover_mode};
+  }
+
+ private:
+  struct Kept {
+    PlayerState::Intention intention;
+    bool recover_mode = false;
+  };
+  std::array<Kept, 2> kept_{};
+  std::string episode_;
+  int cycle_ = -10;
+};
+
 Tally replay(const std::string& file, int agents, int field_defenders, bool verbose) {
   const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   EXPECT_FALSE(rows.empty()) << file;
   Tally t;
   int shown = 0;
-  // Each defender's memory (its queued intention) carries over from its decision on the row before,
-  // within an episode's consecutive cycles.
-  std::array<PlayerState::Intention, 2> memory{};
-  std::array<bool, 2> recover{};
-  std::string memory_episode;
-  int memory_t = -10;
+  DefenderMemory memory;
   for (const CsvRow& r : rows) {
     if (r.str("status") != "IN_GAME") {
       continue;
     }
-    const std::string episode = r.str("src") + "/" + r.str("ep");
-    const int cycle = static_cast<int>(r.num("t"));
-    if (episode != memory_episode || cycle != memory_t + 1) {
-      memory.fill({});
-      recover.fill(false);
-    }
-    memory_episode = episode;
-    memory_t = cycle;
     SoccerState s;
-    s.cycle = cycle;
+    s.cycle = memory.at(r);
     s.num_players = 0;
     for (int a = 0; a < agents; ++a) {
       PlayerState p = player_at(r, "p" + std::to_string(a), true);
@@ -199,8 +219,7 @@ Tally replay(const std::string& file, int agents, int field_defenders, bool verb
     for (int k = 1; k <= field_defenders; ++k) {
       PlayerState d = player_at(r, "d" + std::to_string(k), false);
       d.team = Team::kDefense;
-      d.intention = memory[static_cast<size_t>(k - 1)];
-      d.recover_mode = recover[static_cast<size_t>(k - 1)];
+      memory.give(k - 1, &d);
       s.players[static_cast<size_t>(s.num_players++)] = d;
     }
     s.ball.pos = {r.num("bx"), r.num("by")};
@@ -212,8 +231,7 @@ Tally replay(const std::string& file, int agents, int field_defenders, bool verb
         continue;  // frozen by its tackle (the recording says so only through the missing command)
       }
       const DefenderDecision dec = decide_defender(s, first_defender + k - 1, k + 1, false);
-      memory[static_cast<size_t>(k - 1)] = dec.intention;
-      recover[static_cast<size_t>(k - 1)] = dec.recover_mode;
+      memory.keep(k - 1, dec.intention, dec.recover_mode);
       ++t.cycles;
       const bool kind_ok = cmd == kind_name(dec.command.kind);
       t.kind += kind_ok ? 1 : 0;
@@ -295,39 +313,23 @@ Stepped step_game(const std::string& file, int agents, int field_defenders, bool
   const std::vector<CsvRow> rows = testing::load_csv_rows(data_path(file));
   Stepped out;
   int shown = 0;
-  // Each defender's memory (its queued intention) carries over from the step before, within an
-  // episode's consecutive cycles.
-  std::array<PlayerState::Intention, 2> memory{};
-  std::array<bool, 2> recover{};
-  std::string memory_episode;
-  int memory_t = -10;
+  DefenderMemory memory;
   for (size_t i = 0; i + 1 < rows.size(); ++i) {
     const CsvRow& r = rows[i];
     const CsvRow& n = rows[i + 1];
     if (r.str("status") != "IN_GAME" || n.str("src") != r.str("src") || n.str("ep") != r.str("ep") || r.num("t") < 2) {
       continue;  // the reset cycles and the last row of an episode
     }
-    const std::string episode = r.str("src") + "/" + r.str("ep");
-    const int cycle = static_cast<int>(r.num("t"));
-    if (episode != memory_episode || cycle != memory_t + 1) {
-      memory.fill({});
-      recover.fill(false);
-    }
-    memory_episode = episode;
-    memory_t = cycle;
     SoccerSim sim = game_at(r, agents, field_defenders);
-    sim.mutable_state().cycle = cycle;
+    sim.mutable_state().cycle = memory.at(r);
     for (int k = 0; k < field_defenders; ++k) {
-      PlayerState& d = sim.mutable_state().players[static_cast<size_t>(sim.defender_index(k))];
-      d.intention = memory[static_cast<size_t>(k)];
-      d.recover_mode = recover[static_cast<size_t>(k)];
+      memory.give(k, &sim.mutable_state().players[static_cast<size_t>(sim.defender_index(k))]);
     }
     send_attackers(sim, r, &n, agents);
     sim.step();
     for (int k = 0; k < field_defenders; ++k) {
       const PlayerState& d = sim.state().players[static_cast<size_t>(sim.defender_index(k))];
-      memory[static_cast<size_t>(k)] = d.intention;
-      recover[static_cast<size_t>(k)] = d.recover_mode;
+      memory.keep(k, d.intention, d.recover_mode);
     }
     ++out.rows;
     const SoccerState& s = sim.state();
