@@ -547,6 +547,35 @@ TEST(Cli, SimTraceTakesTheGoaliesMemory) {
   EXPECT_NE(caught[1], "NONE");
 }
 
+// A field defender's memory through STATE.json (issue 83): the ball rolling ahead of it after its
+// self-pass, a queued turn toward the receive point (22, 8) plays first (TURN, its body from 180
+// to 159.4); without the memory it runs at the ball (DASH 100). Each row ends with the defender's
+// command and state, d1_cmd ... d1_body.
+TEST(Cli, SimTraceTakesAFieldDefendersMemory) {
+  const auto first_command = [](const std::string& memory) {
+    const TempFile state(".json", R"({"agent": {"x": 10, "y": -20}, "ball": {"x": 28.6, "y": 5, "vx": -0.8, "vy": 0},
+                                      "goalie": {}, "defenders": [{"x": 30, "y": 5, "body_deg": 180)" +
+                                      memory + "}]}");
+    const TempFile actions(".csv", "DASH,0,0\n");
+    const RunResult r = run_pamdp(
+        "sim trace --no-noise --goalie --init " + quoted(state.path()) + " --actions " + quoted(actions.path()),
+        Capture::kStdoutOnly);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const std::vector<std::string> lines = split(r.output, '\n');
+    EXPECT_GE(lines.size(), 3U) << r.output;
+    if (lines.size() < 3) {
+      return std::string();
+    }
+    const std::vector<std::string> header = split(lines[0], ',');
+    const std::vector<std::string> row = split(lines[2], ',');
+    EXPECT_EQ(header[header.size() - 8], "d1_cmd");
+    EXPECT_EQ(row.size(), header.size());
+    return row.size() == header.size() ? row[header.size() - 8] : std::string();
+  };
+  EXPECT_EQ(first_command(R"(, "intention": {"kind": "dribble", "x": 22, "y": 8, "turns": 1, "dashes": 5})"), "TURN");
+  EXPECT_EQ(first_command(""), "DASH");
+}
+
 // Test names and failure messages show the case's name, not its bytes.
 void PrintTo(const BadInvocation& c, std::ostream* os) {
   *os << c.name;
